@@ -1,0 +1,86 @@
+//! The library's error type.
+//!
+//! Every error names the file it concerns (when there is one) and the cause,
+//! so the command line can print it as one line: `path: cause`.
+
+use std::path::PathBuf;
+
+/// Result alias used throughout the library.
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+/// Everything that can go wrong in flourish. Each variant renders as one
+/// line, `file: cause`, suitable for stderr.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// Reading or writing a file failed.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file concerned.
+        path: PathBuf,
+        /// The operating system's error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A raster file could not be decoded.
+    #[error("{}: not a readable image: {reason}", path.display())]
+    Image {
+        /// The file concerned.
+        path: PathBuf,
+        /// The decoder's explanation.
+        reason: String,
+    },
+    /// An SVG file could not be parsed.
+    #[error("{}: SVG does not parse: {reason}", path.display())]
+    Svg {
+        /// The file concerned.
+        path: PathBuf,
+        /// The parser's explanation.
+        reason: String,
+    },
+    /// An input or requested canvas exceeds the resource limits.
+    #[error("{}: {width}×{height} px exceeds the size limit ({limit})", path.display())]
+    TooLarge {
+        /// The file concerned.
+        path: PathBuf,
+        /// Requested width in pixels.
+        width: u64,
+        /// Requested height in pixels.
+        height: u64,
+        /// The limit, in words (e.g. "16384 px per side, 64 Mpx in all").
+        limit: String,
+    },
+    /// The input is well-formed but cannot be used (degenerate, empty, NaN…).
+    #[error("{}: {reason}", path.display())]
+    Invalid {
+        /// The file concerned.
+        path: PathBuf,
+        /// What is wrong with it.
+        reason: String,
+    },
+    /// An option has a value the library cannot use.
+    #[error("invalid option {name}: {reason}")]
+    Option {
+        /// The option's name as the user knows it (e.g. `--tolerance`).
+        name: &'static str,
+        /// What is wrong with the value.
+        reason: String,
+    },
+}
+
+impl Error {
+    /// An [`Error::Io`] for `path`.
+    pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Error::Io {
+            path: path.into(),
+            source,
+        }
+    }
+
+    /// An [`Error::Invalid`] for `path`.
+    pub fn invalid(path: impl Into<PathBuf>, reason: impl Into<String>) -> Self {
+        Error::Invalid {
+            path: path.into(),
+            reason: reason.into(),
+        }
+    }
+}

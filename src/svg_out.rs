@@ -1,0 +1,514 @@
+//! The SVG writer: documents of groups of filled (or stroked) Bézier paths,
+//! written compactly.
+//!
+//! Path data uses relative commands (`m c l z`), implicit command
+//! repetition, and coordinates quantized to a fixed number of decimals
+//! chosen from the geometry's tolerance. Quantization happens on absolute
+//! coordinates first and relative offsets are differences of quantized
+//! integers, so rounding never accumulates along a path.
+
+use kurbo::{BezPath, PathEl, Point, Rect};
+use std::fmt::Write as _;
+
+/// An sRGB colour, 8 bits per channel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Color {
+    /// Red, 0–255.
+    pub r: u8,
+    /// Green, 0–255.
+    pub g: u8,
+    /// Blue, 0–255.
+    pub b: u8,
+}
+
+impl Color {
+    /// Black, the default ink.
+    pub const BLACK: Color = Color { r: 0, g: 0, b: 0 };
+
+    /// A colour from its three channels.
+    pub const fn rgb(r: u8, g: u8, b: u8) -> Self {
+        Color { r, g, b }
+    }
+
+    /// The colour as SVG wants it: `#rgb` when that is exact, else `#rrggbb`.
+    pub fn to_hex(self) -> String {
+        let short = |c: u8| c % 17 == 0;
+        if short(self.r) && short(self.g) && short(self.b) {
+            format!("#{:x}{:x}{:x}", self.r / 17, self.g / 17, self.b / 17)
+        } else {
+            format!("#{:02x}{:02x}{:02x}", self.r, self.g, self.b)
+        }
+    }
+}
+
+/// How the interior of a path with several subpaths is decided.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum FillRule {
+    /// Non-zero winding: holes must wind the other way (the tracer does).
+    #[default]
+    NonZero,
+    /// Even-odd parity.
+    EvenOdd,
+}
+
+/// A stroke: colour and width in user units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stroke {
+    /// Stroke colour.
+    pub color: Color,
+    /// Stroke width in user units.
+    pub width: f64,
+    /// Line cap: `butt`, `round` or `square`.
+    pub cap: LineCap,
+    /// Line join: `miter`, `round` or `bevel`.
+    pub join: LineJoin,
+}
+
+/// SVG `stroke-linecap`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LineCap {
+    /// Flat end at the endpoint (SVG default).
+    #[default]
+    Butt,
+    /// Half-disc end.
+    Round,
+    /// Half-square end.
+    Square,
+}
+
+/// SVG `stroke-linejoin`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum LineJoin {
+    /// Sharp join (SVG default).
+    #[default]
+    Miter,
+    /// Rounded join.
+    Round,
+    /// Cut-off join.
+    Bevel,
+}
+
+/// One `<path>` element.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Shape {
+    /// Geometry in user units.
+    pub path: BezPath,
+    /// Fill colour, or `None` for `fill="none"`.
+    pub fill: Option<Color>,
+    /// Fill rule for paths with several subpaths.
+    pub fill_rule: FillRule,
+    /// Optional stroke.
+    pub stroke: Option<Stroke>,
+    /// Opacity in 0..=1 (1 is not written).
+    pub opacity: f64,
+}
+
+impl Shape {
+    /// A filled shape with the non-zero rule and no stroke.
+    pub fn filled(path: BezPath, fill: Color) -> Self {
+        Shape {
+            path,
+            fill: Some(fill),
+            fill_rule: FillRule::NonZero,
+            stroke: None,
+            opacity: 1.0,
+        }
+    }
+}
+
+/// One `<g>` element: a query's output or one colour layer.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Group {
+    /// The group's `id` (written only when non-empty).
+    pub id: String,
+    /// The paths, in drawing order.
+    pub shapes: Vec<Shape>,
+}
+
+/// A whole output document.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Document {
+    /// `width` attribute, in user units.
+    pub width: f64,
+    /// `height` attribute, in user units.
+    pub height: f64,
+    /// The `viewBox`.
+    pub view_box: Rect,
+    /// Groups in drawing order.
+    pub groups: Vec<Group>,
+    /// Decimals written for coordinates (see [`decimals_for`]).
+    pub decimals: u32,
+}
+
+/// The number of decimals needed so that rounding moves a point by at most a
+/// tenth of `tolerance` (both in user units), clamped to 0..=6.
+pub fn decimals_for(tolerance: f64) -> u32 {
+    if !(tolerance.is_finite() && tolerance > 0.0) {
+        return 3;
+    }
+    let d = (-(tolerance / 10.0).log10()).ceil();
+    d.clamp(0.0, 6.0) as u32
+}
+
+impl Document {
+    /// An empty document of the given size whose viewBox is `0 0 w h`.
+    pub fn new(width: f64, height: f64, decimals: u32) -> Self {
+        Document {
+            width,
+            height,
+            view_box: Rect::new(0.0, 0.0, width, height),
+            groups: Vec::new(),
+            decimals,
+        }
+    }
+
+    /// Number of drawing segments (lines and curves) in all paths, the
+    /// figure compared with potrace.
+    pub fn segment_count(&self) -> usize {
+        self.groups
+            .iter()
+            .flat_map(|g| &g.shapes)
+            .map(|s| count_segments(&s.path))
+            .sum()
+    }
+
+    /// Serializes the document.
+    pub fn to_svg(&self) -> String {
+        let mut out = String::with_capacity(4096);
+        let d = self.decimals.max(2);
+        let vb = &self.view_box;
+        let _ = writeln!(
+            out,
+            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{}\" height=\"{}\" viewBox=\"{} {} {} {}\">",
+            fmt_num(self.width, d),
+            fmt_num(self.height, d),
+            fmt_num(vb.x0, d),
+            fmt_num(vb.y0, d),
+            fmt_num(vb.width(), d),
+            fmt_num(vb.height(), d),
+        );
+        for g in &self.groups {
+            if g.id.is_empty() {
+                out.push_str("<g>\n");
+            } else {
+                let _ = writeln!(out, "<g id=\"{}\">", escape_attr(&g.id));
+            }
+            for s in &g.shapes {
+                let data = path_data(&s.path, self.decimals);
+                if data.is_empty() {
+                    continue;
+                }
+                out.push_str("<path");
+                match s.fill {
+                    Some(c) => {
+                        let _ = write!(out, " fill=\"{}\"", c.to_hex());
+                        let rule = match s.fill_rule {
+                            FillRule::NonZero => "nonzero",
+                            FillRule::EvenOdd => "evenodd",
+                        };
+                        let _ = write!(out, " fill-rule=\"{rule}\"");
+                    }
+                    None => out.push_str(" fill=\"none\""),
+                }
+                if let Some(st) = &s.stroke {
+                    let _ = write!(
+                        out,
+                        " stroke=\"{}\" stroke-width=\"{}\"",
+                        st.color.to_hex(),
+                        fmt_num(st.width, d)
+                    );
+                    match st.cap {
+                        LineCap::Butt => {}
+                        LineCap::Round => out.push_str(" stroke-linecap=\"round\""),
+                        LineCap::Square => out.push_str(" stroke-linecap=\"square\""),
+                    }
+                    match st.join {
+                        LineJoin::Miter => {}
+                        LineJoin::Round => out.push_str(" stroke-linejoin=\"round\""),
+                        LineJoin::Bevel => out.push_str(" stroke-linejoin=\"bevel\""),
+                    }
+                }
+                if s.opacity < 1.0 {
+                    let _ = write!(out, " opacity=\"{}\"", fmt_num(s.opacity.max(0.0), 3));
+                }
+                let _ = writeln!(out, " d=\"{data}\"/>");
+            }
+            out.push_str("</g>\n");
+        }
+        out.push_str("</svg>\n");
+        out
+    }
+}
+
+fn escape_attr(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('"', "&quot;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
+/// Number of lines and curves in a path (moves and closes excluded).
+pub fn count_segments(path: &BezPath) -> usize {
+    path.elements()
+        .iter()
+        .filter(|e| {
+            matches!(
+                e,
+                PathEl::LineTo(_) | PathEl::QuadTo(..) | PathEl::CurveTo(..)
+            )
+        })
+        .count()
+}
+
+/// Formats `v` with at most `decimals` decimals, trailing zeros and a
+/// leading zero dropped (`0.5` → `.5`).
+pub fn fmt_num(v: f64, decimals: u32) -> String {
+    let scale = 10f64.powi(decimals as i32);
+    let q = (v * scale).round();
+    fmt_fixed(q as i64, decimals)
+}
+
+/// Formats the integer `q` as a decimal with `decimals` implied decimals.
+fn fmt_fixed(q: i64, decimals: u32) -> String {
+    let neg = q < 0;
+    let a = q.unsigned_abs();
+    let scale = 10u64.pow(decimals);
+    let int = a / scale;
+    let mut frac = a % scale;
+    let mut s = String::new();
+    if neg && a != 0 {
+        s.push('-');
+    }
+    if int != 0 || frac == 0 {
+        let _ = write!(s, "{int}");
+    }
+    if frac != 0 {
+        let mut digits = decimals as usize;
+        while frac % 10 == 0 {
+            frac /= 10;
+            digits -= 1;
+        }
+        let _ = write!(s, ".{frac:0digits$}");
+    }
+    s
+}
+
+/// Appends numbers to path data with the fewest separators SVG allows.
+struct DataWriter {
+    out: String,
+    last_cmd: Option<char>,
+    last_has_dot: bool,
+    decimals: u32,
+}
+
+impl DataWriter {
+    fn cmd(&mut self, c: char) {
+        // `m` is followed by implicit `l`s; other commands repeat themselves.
+        let implicit = match self.last_cmd {
+            Some('m') => c == 'l',
+            Some(prev) => prev == c && c != 'z' && c != 'm',
+            None => false,
+        };
+        if !implicit {
+            self.out.push(c);
+            self.last_has_dot = false;
+        }
+        self.last_cmd = Some(c);
+        if c == 'z' {
+            self.last_cmd = Some('z');
+        }
+    }
+
+    fn num(&mut self, q: i64) {
+        let s = fmt_fixed(q, self.decimals);
+        let needs_sep = match self.out.chars().last() {
+            None => false,
+            Some(ch) if ch.is_ascii_alphabetic() => false,
+            Some(_) => !(s.starts_with('-') || (s.starts_with('.') && self.last_has_dot)),
+        };
+        if needs_sep {
+            self.out.push(' ');
+        }
+        self.last_has_dot = s.contains('.');
+        self.out.push_str(&s);
+    }
+}
+
+/// Compact relative path data for `path` with `decimals` decimals.
+pub fn path_data(path: &BezPath, decimals: u32) -> String {
+    let scale = 10f64.powi(decimals as i32);
+    let quant = |p: Point| -> (i64, i64) { ((p.x * scale).round() as i64, (p.y * scale).round() as i64) };
+    // Half a quantum: control points this close to the chord make a line.
+    let line_eps = 0.5 / scale;
+    let mut w = DataWriter {
+        out: String::new(),
+        last_cmd: None,
+        last_has_dot: false,
+        decimals,
+    };
+    let mut cur = (0i64, 0i64);
+    let mut start = (0i64, 0i64);
+    let mut cur_pt = Point::ZERO;
+    let els = path.elements();
+    for (i, el) in els.iter().enumerate() {
+        match *el {
+            PathEl::MoveTo(p) => {
+                let q = quant(p);
+                w.cmd('m');
+                w.num(q.0 - cur.0);
+                w.num(q.1 - cur.1);
+                cur = q;
+                start = q;
+                cur_pt = p;
+            }
+            PathEl::LineTo(p) => {
+                let q = quant(p);
+                let closes_next = q == start && matches!(els.get(i + 1), Some(PathEl::ClosePath));
+                if q != cur && !closes_next {
+                    w.cmd('l');
+                    w.num(q.0 - cur.0);
+                    w.num(q.1 - cur.1);
+                }
+                cur = q;
+                cur_pt = p;
+            }
+            PathEl::QuadTo(p1, p2) => {
+                let c1 = cur_pt + (p1 - cur_pt) * (2.0 / 3.0);
+                let c2 = p2 + (p1 - p2) * (2.0 / 3.0);
+                emit_cubic(&mut w, &mut cur, start, cur_pt, c1, c2, p2, &quant, line_eps, els.get(i + 1));
+                cur_pt = p2;
+            }
+            PathEl::CurveTo(p1, p2, p3) => {
+                emit_cubic(&mut w, &mut cur, start, cur_pt, p1, p2, p3, &quant, line_eps, els.get(i + 1));
+                cur_pt = p3;
+            }
+            PathEl::ClosePath => {
+                w.cmd('z');
+                cur = start;
+            }
+        }
+    }
+    w.out
+}
+
+#[allow(clippy::too_many_arguments)]
+fn emit_cubic(
+    w: &mut DataWriter,
+    cur: &mut (i64, i64),
+    start: (i64, i64),
+    p0: Point,
+    p1: Point,
+    p2: Point,
+    p3: Point,
+    quant: &impl Fn(Point) -> (i64, i64),
+    line_eps: f64,
+    next: Option<&PathEl>,
+) {
+    let q3 = quant(p3);
+    if is_straight(p0, p1, p2, p3, line_eps) {
+        let closes_next = q3 == start && matches!(next, Some(PathEl::ClosePath));
+        if q3 != *cur && !closes_next {
+            w.cmd('l');
+            w.num(q3.0 - cur.0);
+            w.num(q3.1 - cur.1);
+        }
+    } else {
+        let q1 = quant(p1);
+        let q2 = quant(p2);
+        w.cmd('c');
+        for q in [q1, q2, q3] {
+            w.num(q.0 - cur.0);
+            w.num(q.1 - cur.1);
+        }
+    }
+    *cur = q3;
+}
+
+/// True when the cubic's control points lie on its chord, between its ends.
+fn is_straight(p0: Point, p1: Point, p2: Point, p3: Point, eps: f64) -> bool {
+    let chord = p3 - p0;
+    let len2 = chord.hypot2();
+    if len2 < eps * eps {
+        return (p1 - p0).hypot() < eps && (p2 - p0).hypot() < eps;
+    }
+    let len = len2.sqrt();
+    [p1, p2].iter().all(|&p| {
+        let v = p - p0;
+        let along = v.dot(chord) / len2;
+        let off = v.cross(chord).abs() / len;
+        off <= eps && (-1e-9..=1.0 + 1e-9).contains(&along)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_are_compact() {
+        assert_eq!(fmt_num(0.5, 2), ".5");
+        assert_eq!(fmt_num(-0.5, 2), "-.5");
+        assert_eq!(fmt_num(12.0, 2), "12");
+        assert_eq!(fmt_num(12.345, 2), "12.35");
+        assert_eq!(fmt_num(-0.001, 2), "0");
+        assert_eq!(fmt_num(1.10, 3), "1.1");
+    }
+
+    #[test]
+    fn path_data_is_relative_and_closed() {
+        let mut p = BezPath::new();
+        p.move_to((10.0, 10.0));
+        p.line_to((20.0, 10.0));
+        p.curve_to((25.0, 10.0), (25.0, 20.0), (20.0, 20.0));
+        p.line_to((10.0, 10.0));
+        p.close_path();
+        p.move_to((12.5, 12.5));
+        p.line_to((13.5, 12.5));
+        p.line_to((13.5, 13.5));
+        p.close_path();
+        let d = path_data(&p, 2);
+        assert_eq!(d, "m10 10 10 0c5 0 5 10 0 10zm2.5 2.5 1 0 0 1z");
+    }
+
+    #[test]
+    fn straight_cubics_become_lines() {
+        let mut p = BezPath::new();
+        p.move_to((0.0, 0.0));
+        p.curve_to((1.0, 1.0), (2.0, 2.0), (3.0, 3.0));
+        p.curve_to((4.0, 3.0), (5.0, 3.0), (6.0, 3.0));
+        assert_eq!(path_data(&p, 2), "m0 0 3 3 3 0");
+    }
+
+    #[test]
+    fn rounding_does_not_drift() {
+        // Many small steps of 0.004 rounded at 2 decimals must still land at
+        // the true end point.
+        let mut p = BezPath::new();
+        p.move_to((0.0, 0.0));
+        for i in 1..=1000 {
+            p.line_to((i as f64 * 0.004, 0.0));
+        }
+        let d = path_data(&p, 2);
+        let total: f64 = d
+            .trim_start_matches("m0 0")
+            .split(' ')
+            .filter(|s| !s.is_empty())
+            .step_by(2)
+            .map(|s| s.parse::<f64>().unwrap())
+            .sum();
+        assert!((total - 4.0).abs() < 1e-9, "{total}");
+    }
+
+    #[test]
+    fn colours() {
+        assert_eq!(Color::rgb(255, 0, 0).to_hex(), "#f00");
+        assert_eq!(Color::rgb(18, 52, 86).to_hex(), "#123456");
+    }
+
+    #[test]
+    fn decimals_follow_tolerance() {
+        assert_eq!(decimals_for(0.25), 2);
+        assert_eq!(decimals_for(1.0), 1);
+        assert_eq!(decimals_for(0.01), 3);
+    }
+}
