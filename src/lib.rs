@@ -12,6 +12,8 @@
 #![warn(missing_docs)]
 
 pub mod error;
+pub mod io;
+pub mod render;
 pub mod svg_out;
 
 pub use error::{Error, Result};

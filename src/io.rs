@@ -1,0 +1,112 @@
+//! File input and output shared by every mode: safe SVG parsing, size caps,
+//! and atomic writes (a temporary file renamed into place, so a failure never
+//! leaves a partial output).
+
+use crate::error::{Error, Result};
+use resvg::usvg;
+use std::io::Write as _;
+use std::path::Path;
+
+/// Largest input file read, in bytes (256 MiB).
+pub const MAX_FILE_BYTES: u64 = 256 << 20;
+
+/// Largest raster side in pixels, for inputs and canvases.
+pub const MAX_SIDE: u64 = 16_384;
+
+/// Largest raster area in pixels (64 Mpx), for inputs and canvases.
+pub const MAX_PIXELS: u64 = 64 << 20;
+
+/// Checks a raster size against [`MAX_SIDE`] and [`MAX_PIXELS`] before
+/// anything is allocated.
+pub fn check_canvas(path: &Path, width: u64, height: u64) -> Result<()> {
+    if width == 0 || height == 0 {
+        return Err(Error::invalid(path, format!("empty canvas ({width}×{height} px)")));
+    }
+    if width > MAX_SIDE || height > MAX_SIDE || width.saturating_mul(height) > MAX_PIXELS {
+        return Err(Error::TooLarge {
+            path: path.to_path_buf(),
+            width,
+            height,
+            limit: format!("{MAX_SIDE} px per side, {} Mpx in all", MAX_PIXELS >> 20),
+        });
+    }
+    Ok(())
+}
+
+/// Reads a whole file, refusing files over [`MAX_FILE_BYTES`].
+pub fn read_file(path: &Path) -> Result<Vec<u8>> {
+    let meta = std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
+    if meta.is_dir() {
+        return Err(Error::invalid(path, "is a directory, not a file"));
+    }
+    if meta.len() > MAX_FILE_BYTES {
+        return Err(Error::invalid(
+            path,
+            format!("file of {} bytes exceeds the limit of {MAX_FILE_BYTES} bytes", meta.len()),
+        ));
+    }
+    std::fs::read(path).map_err(|e| Error::io(path, e))
+}
+
+/// usvg options that never touch the file system or the network: external
+/// and embedded images are ignored, no fonts are loaded.
+pub fn svg_options() -> usvg::Options<'static> {
+    usvg::Options {
+        resources_dir: None,
+        image_href_resolver: usvg::ImageHrefResolver {
+            resolve_data: Box::new(|_, _, _| None),
+            resolve_string: Box::new(|_, _| None),
+        },
+        ..usvg::Options::default()
+    }
+}
+
+/// Parses SVG bytes with [`svg_options`]; `path` names the file in errors.
+pub fn parse_svg(path: &Path, data: &[u8]) -> Result<usvg::Tree> {
+    let tree = usvg::Tree::from_data(data, &svg_options()).map_err(|e| Error::Svg {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
+    })?;
+    let size = tree.size();
+    if !(size.width().is_finite() && size.height().is_finite()) {
+        return Err(Error::invalid(path, "SVG size is not finite"));
+    }
+    Ok(tree)
+}
+
+/// Reads and parses an SVG file.
+pub fn load_svg(path: &Path) -> Result<usvg::Tree> {
+    let data = read_file(path)?;
+    parse_svg(path, &data)
+}
+
+/// Writes `bytes` to `path` atomically: into a temporary file in the same
+/// folder, then renamed over `path`. `-` writes to standard output.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    if path.as_os_str() == "-" {
+        let mut out = std::io::stdout().lock();
+        out.write_all(bytes).map_err(|e| Error::io("<stdout>", e))?;
+        return out.flush().map_err(|e| Error::io("<stdout>", e));
+    }
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let mut tmp = tempfile::Builder::new()
+        .prefix(".flourish-")
+        .suffix(".tmp")
+        .tempfile_in(dir)
+        .map_err(|e| Error::io(path, e))?;
+    tmp.write_all(bytes).map_err(|e| Error::io(path, e))?;
+    tmp.flush().map_err(|e| Error::io(path, e))?;
+    tmp.persist(path).map_err(|e| Error::io(path, e.error))?;
+    Ok(())
+}
+
+/// True when `a` and `b` name the same existing file (or the same path).
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => a == b,
+    }
+}
