@@ -11,9 +11,12 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod diff;
 pub mod error;
 pub mod io;
+pub mod raster;
 pub mod render;
 pub mod svg_out;
+pub mod trace;
 
 pub use error::{Error, Result};

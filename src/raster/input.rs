@@ -1,0 +1,602 @@
+//! Loading `trace` inputs as layers of ink, each a signed distance field.
+//!
+//! * Raster files (through `image`): ink coverage is the alpha channel when
+//!   the image has transparency, else the darkness `1 − luminance`;
+//!   anti-aliased edges are kept as fractional coverage and turned into a
+//!   sub-pixel SDF ([`Sdf::from_coverage`]).
+//! * SVG files (through usvg): rasterized so the longest side is
+//!   `resolution` px; inside/outside is sampled at pixel centres and the
+//!   SDF is the exact distance to the vector outline
+//!   ([`Sdf::from_segments`]). Strokes count as ink (converted to fills).
+//!
+//! With `layers`, each distinct fill colour (SVG) or quantized colour
+//! (raster) is its own layer; layers are stacked bottom to top and each one
+//! extends under the layers above it, so stacked fills leave no seams.
+
+use super::{Coverage, Grid, Sdf};
+use crate::error::{Error, Result};
+use crate::io;
+use crate::svg_out::Color;
+use kurbo::{Affine, BezPath, Line, PathEl, Point};
+use resvg::tiny_skia;
+use resvg::usvg;
+use std::path::Path;
+
+/// How inputs are read.
+#[derive(Clone, Debug)]
+pub struct InputOptions {
+    /// Longest side in pixels at which SVG input is rasterized (default
+    /// 1024). Raster input is used at its own size.
+    pub resolution: u32,
+    /// Trace the paper instead of the ink.
+    pub invert: bool,
+    /// One layer per fill colour instead of one layer of all ink.
+    pub layers: bool,
+}
+
+impl Default for InputOptions {
+    fn default() -> Self {
+        InputOptions {
+            resolution: 1024,
+            invert: false,
+            layers: false,
+        }
+    }
+}
+
+/// One layer of ink.
+#[derive(Clone, Debug)]
+pub struct InkLayer {
+    /// The layer's colour.
+    pub color: Color,
+    /// Its signed distance field.
+    pub sdf: Sdf,
+}
+
+/// An input read as ink: its size in its own user units and its layers,
+/// bottom first.
+#[derive(Clone, Debug)]
+pub struct Ink {
+    /// Width in user units (pixels for raster input).
+    pub width: f64,
+    /// Height in user units.
+    pub height: f64,
+    /// Layers, bottom first.
+    pub layers: Vec<InkLayer>,
+}
+
+/// Reads `path` (raster or SVG, told apart by content) as ink.
+pub fn load(path: &Path, opts: &InputOptions) -> Result<Ink> {
+    let bytes = io::read_file(path)?;
+    if looks_like_svg(&bytes) {
+        load_svg(path, &bytes, opts)
+    } else {
+        load_raster(path, &bytes, opts)
+    }
+}
+
+fn looks_like_svg(bytes: &[u8]) -> bool {
+    let head = &bytes[..bytes.len().min(512)];
+    let text = String::from_utf8_lossy(head);
+    let t = text.trim_start_matches('\u{feff}').trim_start();
+    t.starts_with('<') || bytes.starts_with(&[0x1f, 0x8b])
+}
+
+/// Decodes raster bytes, refusing oversized images before decoding.
+pub fn decode_raster(path: &Path, bytes: &[u8]) -> Result<image::DynamicImage> {
+    let bad = |e: &dyn std::fmt::Display| Error::Image {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
+    };
+    let reader = image::ImageReader::new(std::io::Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| bad(&e))?;
+    if reader.format().is_none() {
+        return Err(Error::Image {
+            path: path.to_path_buf(),
+            reason: "unknown format (expected PNG, JPEG, BMP, GIF, TIFF, WebP or SVG)".into(),
+        });
+    }
+    let (w, h) = reader.into_dimensions().map_err(|e| bad(&e))?;
+    io::check_canvas(path, w as u64, h as u64)?;
+    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| bad(&e))?;
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(io::MAX_SIDE as u32);
+    limits.max_image_height = Some(io::MAX_SIDE as u32);
+    limits.max_alloc = Some(io::MAX_PIXELS * 8);
+    reader.limits(limits);
+    reader.decode().map_err(|e| bad(&e))
+}
+
+fn load_raster(path: &Path, bytes: &[u8], opts: &InputOptions) -> Result<Ink> {
+    let img = decode_raster(path, bytes)?.to_rgba8();
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    let has_alpha = img.pixels().any(|p| p[3] < 255);
+    let px: Vec<[u8; 4]> = img.pixels().map(|p| p.0).collect();
+    let to_user = Affine::IDENTITY;
+    let layers = if opts.layers {
+        quantized_layers(&px, w, h, has_alpha, opts.invert)
+            .into_iter()
+            .map(|(color, cov)| InkLayer {
+                color,
+                sdf: Sdf::from_coverage(&cov, to_user),
+            })
+            .collect()
+    } else {
+        let cov = Grid::from_vec(
+            w,
+            h,
+            px.iter()
+                .map(|p| {
+                    let c = if has_alpha { p[3] as f32 / 255.0 } else { 1.0 - luma(p) };
+                    if opts.invert {
+                        1.0 - c
+                    } else {
+                        c
+                    }
+                })
+                .collect(),
+        )
+        .expect("sizes match");
+        let color = mean_ink_colour(&px, &cov);
+        vec![InkLayer {
+            color,
+            sdf: Sdf::from_coverage(&cov, to_user),
+        }]
+    };
+    Ok(Ink {
+        width: w as f64,
+        height: h as f64,
+        layers,
+    })
+}
+
+fn luma(p: &[u8; 4]) -> f32 {
+    (0.2126 * p[0] as f32 + 0.7152 * p[1] as f32 + 0.0722 * p[2] as f32) / 255.0
+}
+
+/// The mean colour of fully inked pixels, black when there are none.
+fn mean_ink_colour(px: &[[u8; 4]], cov: &Coverage) -> Color {
+    let mut sum = [0u64; 3];
+    let mut n = 0u64;
+    for (p, &c) in px.iter().zip(cov.data()) {
+        if c > 0.95 {
+            for k in 0..3 {
+                sum[k] += p[k] as u64;
+            }
+            n += 1;
+        }
+    }
+    if n == 0 {
+        return Color::BLACK;
+    }
+    Color::rgb((sum[0] / n) as u8, (sum[1] / n) as u8, (sum[2] / n) as u8)
+}
+
+/// Splits a colour raster into stacked layers: a palette of dominant colours
+/// (the paper colour, most common on the border, excluded), each pixel
+/// explained as a mix of its two nearest palette colours (anti-aliasing),
+/// and layer `k` covering its own colour and every colour stacked above it.
+fn quantized_layers(px: &[[u8; 4]], w: usize, h: usize, has_alpha: bool, invert: bool) -> Vec<(Color, Coverage)> {
+    // Composite over white so transparency reads as paper.
+    let rgb: Vec<[f32; 3]> = px
+        .iter()
+        .map(|p| {
+            let a = if has_alpha { p[3] as f32 / 255.0 } else { 1.0 };
+            [0, 1, 2].map(|k| p[k] as f32 * a + 255.0 * (1.0 - a))
+        })
+        .collect();
+    let key = |c: &[f32; 3]| ((c[0] as u32 >> 4) << 8) | ((c[1] as u32 >> 4) << 4) | (c[2] as u32 >> 4);
+    let mut hist = std::collections::BTreeMap::<u32, (u64, [f64; 3])>::new();
+    for c in &rgb {
+        let e = hist.entry(key(c)).or_insert((0, [0.0; 3]));
+        e.0 += 1;
+        for k in 0..3 {
+            e.1[k] += c[k] as f64;
+        }
+    }
+    let mut bins: Vec<(u64, [f32; 3])> = hist
+        .values()
+        .map(|(n, s)| (*n, [0, 1, 2].map(|k| (s[k] / *n as f64) as f32)))
+        .collect();
+    bins.sort_by(|a, b| b.0.cmp(&a.0).then(a.1.partial_cmp(&b.1).unwrap_or(std::cmp::Ordering::Equal)));
+    let min_count = ((w * h) as u64 / 500).max(1);
+    let dist2 = |a: &[f32; 3], b: &[f32; 3]| (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f32>();
+    let mut palette: Vec<[f32; 3]> = Vec::new();
+    for (n, c) in &bins {
+        if *n < min_count || palette.len() >= 8 {
+            break;
+        }
+        if palette.iter().all(|p| dist2(p, c) > 48.0 * 48.0) {
+            palette.push(*c);
+        }
+    }
+    // Paper: the most common colour on the border (white if none).
+    let mut border = std::collections::BTreeMap::<u32, usize>::new();
+    for (i, c) in rgb.iter().enumerate() {
+        let (x, y) = (i % w, i / w);
+        if x == 0 || y == 0 || x + 1 == w || y + 1 == h {
+            *border.entry(key(c)).or_default() += 1;
+        }
+    }
+    let paper_key = border.iter().max_by_key(|(k, n)| (**n, std::cmp::Reverse(**k))).map(|(k, _)| *k);
+    let paper = palette
+        .iter()
+        .position(|p| Some(key(p)) == paper_key)
+        .or_else(|| palette.iter().position(|p| dist2(p, &[255.0; 3]) < 48.0 * 48.0));
+    let paper_colour = paper.map(|i| palette[i]).unwrap_or([255.0; 3]);
+    if let Some(i) = paper {
+        palette.remove(i);
+    }
+    palette.insert(0, paper_colour);
+    if invert {
+        // Inverting swaps the roles: trace the paper as the only layer.
+        palette.truncate(1);
+    }
+    let k = palette.len();
+    // Per pixel, weights of its two nearest palette colours.
+    let mut weights = vec![0f32; w * h * k];
+    for (i, c) in rgb.iter().enumerate() {
+        let mut best = (f32::MAX, 0usize, 0usize, 1.0f32);
+        for a in 0..k {
+            for b in a..k {
+                let (pa, pb) = (&palette[a], &palette[b]);
+                let d = [0, 1, 2].map(|j| pa[j] - pb[j]);
+                let dd: f32 = d.iter().map(|v| v * v).sum();
+                let t = if dd > 0.0 {
+                    (((0..3).map(|j| (c[j] - pb[j]) * d[j]).sum::<f32>()) / dd).clamp(0.0, 1.0)
+                } else {
+                    1.0
+                };
+                let mix = [0, 1, 2].map(|j| pb[j] + t * d[j]);
+                let e = dist2(&mix, c);
+                if e < best.0 {
+                    best = (e, a, b, t);
+                }
+            }
+        }
+        let (_, a, b, t) = best;
+        weights[i * k + a] += t;
+        weights[i * k + b] += 1.0 - t;
+    }
+    if invert {
+        let cov = Grid::from_fn(w, h, |x, y| weights[(y * w + x) * k]);
+        let c = palette[0];
+        return vec![(Color::rgb(c[0] as u8, c[1] as u8, c[2] as u8), cov)];
+    }
+    // Stack by area, largest at the bottom.
+    let mut order: Vec<usize> = (1..k).collect();
+    let area = |j: usize| (0..w * h).map(|i| weights[i * k + j] as f64).sum::<f64>();
+    let areas: Vec<f64> = (0..k).map(area).collect();
+    order.sort_by(|&a, &b| areas[b].total_cmp(&areas[a]).then(a.cmp(&b)));
+    order
+        .iter()
+        .enumerate()
+        .filter(|(_, &j)| areas[j] > 0.0)
+        .map(|(pos, &j)| {
+            let above = &order[pos..];
+            let cov = Grid::from_fn(w, h, |x, y| {
+                let i = y * w + x;
+                above.iter().map(|&m| weights[i * k + m]).sum::<f32>().min(1.0)
+            });
+            let c = palette[j];
+            (Color::rgb(c[0].round() as u8, c[1].round() as u8, c[2].round() as u8), cov)
+        })
+        .collect()
+}
+
+/// One filled shape of an SVG, in pixel coordinates.
+struct SvgShape {
+    color: Color,
+    /// The tiny-skia path and the transform placing it on the pixel canvas.
+    path: tiny_skia::Path,
+    transform: tiny_skia::Transform,
+    rule: tiny_skia::FillRule,
+}
+
+fn paint_colour(paint: &usvg::Paint) -> Color {
+    let c = match paint {
+        usvg::Paint::Color(c) => *c,
+        usvg::Paint::LinearGradient(g) => g.stops().first().map(|s| s.color()).unwrap_or(usvg::Color::black()),
+        usvg::Paint::RadialGradient(g) => g.stops().first().map(|s| s.color()).unwrap_or(usvg::Color::black()),
+        usvg::Paint::Pattern(_) => usvg::Color::black(),
+    };
+    Color::rgb(c.red, c.green, c.blue)
+}
+
+fn collect_shapes(group: &usvg::Group, canvas: tiny_skia::Transform, out: &mut Vec<SvgShape>) {
+    for node in group.children() {
+        match node {
+            usvg::Node::Group(g) => collect_shapes(g, canvas, out),
+            usvg::Node::Path(p) if p.is_visible() => {
+                let transform = p.abs_transform().post_concat(canvas);
+                if let Some(fill) = p.fill() {
+                    if fill.opacity().get() > 0.0 {
+                        let rule = match fill.rule() {
+                            usvg::FillRule::NonZero => tiny_skia::FillRule::Winding,
+                            usvg::FillRule::EvenOdd => tiny_skia::FillRule::EvenOdd,
+                        };
+                        out.push(SvgShape {
+                            color: paint_colour(fill.paint()),
+                            path: p.data().clone(),
+                            transform,
+                            rule,
+                        });
+                    }
+                }
+                if let Some(stroke) = p.stroke() {
+                    if stroke.opacity().get() > 0.0 {
+                        let res = transform.get_scale().0.max(transform.get_scale().1).max(1e-3);
+                        if let Some(outline) = p.data().stroke(&stroke.to_tiny_skia(), res) {
+                            out.push(SvgShape {
+                                color: paint_colour(stroke.paint()),
+                                path: outline,
+                                transform,
+                                rule: tiny_skia::FillRule::Winding,
+                            });
+                        }
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+}
+
+/// A tiny-skia path as a kurbo path with `transform` applied.
+pub fn to_kurbo(path: &tiny_skia::Path, transform: tiny_skia::Transform) -> BezPath {
+    let t = transform;
+    let affine = Affine::new([t.sx as f64, t.ky as f64, t.kx as f64, t.sy as f64, t.tx as f64, t.ty as f64]);
+    let pt = |p: tiny_skia::Point| Point::new(p.x as f64, p.y as f64);
+    let mut out = BezPath::new();
+    for seg in path.segments() {
+        match seg {
+            tiny_skia::PathSegment::MoveTo(p) => out.move_to(pt(p)),
+            tiny_skia::PathSegment::LineTo(p) => out.line_to(pt(p)),
+            tiny_skia::PathSegment::QuadTo(a, b) => out.quad_to(pt(a), pt(b)),
+            tiny_skia::PathSegment::CubicTo(a, b, c) => out.curve_to(pt(a), pt(b), pt(c)),
+            tiny_skia::PathSegment::Close => out.close_path(),
+        }
+    }
+    affine * out
+}
+
+/// The line segments of `path` flattened to within `tolerance`, with open
+/// subpaths closed (fills close them implicitly).
+pub fn flatten_segments(path: &BezPath, tolerance: f64, out: &mut Vec<Line>) {
+    let mut start = None;
+    let mut last = Point::ZERO;
+    kurbo::flatten(path, tolerance, |el| match el {
+        PathEl::MoveTo(p) => {
+            if let Some(s) = start {
+                if last != s {
+                    out.push(Line::new(last, s));
+                }
+            }
+            start = Some(p);
+            last = p;
+        }
+        PathEl::LineTo(p) => {
+            out.push(Line::new(last, p));
+            last = p;
+        }
+        PathEl::ClosePath => {
+            if let Some(s) = start {
+                if last != s {
+                    out.push(Line::new(last, s));
+                }
+                last = s;
+            }
+        }
+        _ => {}
+    });
+    if let Some(s) = start {
+        if last != s {
+            out.push(Line::new(last, s));
+        }
+    }
+}
+
+/// A shape flattened to line segments in pixel space, with its fill rule.
+struct FlatShape {
+    segments: Vec<Line>,
+    even_odd: bool,
+    bbox: kurbo::Rect,
+}
+
+impl FlatShape {
+    fn new(shape: &SvgShape) -> Self {
+        let mut segments = Vec::new();
+        flatten_segments(&to_kurbo(&shape.path, shape.transform), FLATTEN_PX, &mut segments);
+        let mut bbox = kurbo::Rect::new(f64::MAX, f64::MAX, f64::MIN, f64::MIN);
+        for l in &segments {
+            bbox = bbox.union_pt(l.p0).union_pt(l.p1);
+        }
+        FlatShape {
+            segments,
+            even_odd: shape.rule == tiny_skia::FillRule::EvenOdd,
+            bbox,
+        }
+    }
+
+    /// Winding number of the outline around `p` (crossings of a ray to +x).
+    fn winding(&self, p: Point) -> i32 {
+        let mut w = 0;
+        for l in &self.segments {
+            let (a, b) = (l.p0, l.p1);
+            if (a.y <= p.y) != (b.y <= p.y) {
+                let x = a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x);
+                if x > p.x {
+                    w += if b.y > a.y { 1 } else { -1 };
+                }
+            }
+        }
+        w
+    }
+
+    fn contains(&self, p: Point) -> bool {
+        if !self.bbox.contains(p) {
+            return false;
+        }
+        let w = self.winding(p);
+        if self.even_odd {
+            w % 2 != 0
+        } else {
+            w != 0
+        }
+    }
+}
+
+/// Flattening tolerance for SVG outlines, in pixels.
+const FLATTEN_PX: f64 = 0.01;
+
+/// Pixel centres inside the union of `shapes`, by exact scanline crossing
+/// counts with each shape's own fill rule.
+fn scan_inside(w: usize, h: usize, shapes: &[FlatShape]) -> Grid<bool> {
+    let mut grid = Grid::new(w, h, false);
+    let mut rows: Vec<Vec<(f64, i32)>> = vec![Vec::new(); h];
+    for shape in shapes {
+        for r in rows.iter_mut() {
+            r.clear();
+        }
+        for l in &shape.segments {
+            let (a, b) = (l.p0, l.p1);
+            if a.y == b.y {
+                continue;
+            }
+            let (lo, hi) = (a.y.min(b.y), a.y.max(b.y));
+            // Rows whose centre y + 0.5 lies in [lo, hi).
+            let r0 = (lo - 0.5).ceil().max(0.0) as usize;
+            let r1 = ((hi - 0.5).ceil().max(0.0) as usize).min(h);
+            let dir = if b.y > a.y { 1 } else { -1 };
+            for (r, row) in rows.iter_mut().enumerate().take(r1).skip(r0) {
+                let y = r as f64 + 0.5;
+                let x = a.x + (y - a.y) / (b.y - a.y) * (b.x - a.x);
+                row.push((x, dir));
+            }
+        }
+        for (r, row) in rows.iter_mut().enumerate() {
+            if row.is_empty() {
+                continue;
+            }
+            row.sort_by(|p, q| p.0.total_cmp(&q.0));
+            let mut wind = 0;
+            for k in 0..row.len() - 1 {
+                wind += row[k].1;
+                let inside = if shape.even_odd { wind % 2 != 0 } else { wind != 0 };
+                if !inside {
+                    continue;
+                }
+                // Pixel centres x + 0.5 in [row[k].0, row[k + 1].0).
+                let x0 = (row[k].0 - 0.5).ceil().max(0.0) as usize;
+                let x1 = ((row[k + 1].0 - 0.5).ceil().max(0.0) as usize).min(w);
+                for x in x0..x1 {
+                    grid.set(x, r, true);
+                }
+            }
+        }
+    }
+    grid
+}
+
+/// The parts of the shapes' outlines that bound their union: a segment piece
+/// whose two sides are both inside (an edge of one shape buried in another,
+/// or in itself) or both outside is dropped.
+fn union_boundary(shapes: &[FlatShape]) -> Vec<Line> {
+    use rayon::prelude::*;
+    shapes
+        .par_iter()
+        .enumerate()
+        .flat_map_iter(|(i, shape)| {
+            let others: Vec<&FlatShape> = shapes
+                .iter()
+                .enumerate()
+                .filter(|(j, o)| *j != i && o.bbox.intersect(shape.bbox).area() >= 0.0 && overlaps(o.bbox, shape.bbox))
+                .map(|(_, o)| o)
+                .collect();
+            let lonely = others.is_empty();
+            shape.segments.iter().filter_map(move |l| {
+                let d = l.p1 - l.p0;
+                let len = d.hypot();
+                if len <= 0.0 {
+                    return None;
+                }
+                if lonely && !shape.even_odd {
+                    // A lone nonzero shape: only self-overlaps can bury edges.
+                    let m = l.p0.midpoint(l.p1);
+                    let nrm = kurbo::Vec2::new(-d.y, d.x) / len * 0.05;
+                    let (a, b) = (shape.winding(m + nrm), shape.winding(m - nrm));
+                    return ((a == 0) != (b == 0)).then_some(*l);
+                }
+                let m = l.p0.midpoint(l.p1);
+                let nrm = kurbo::Vec2::new(-d.y, d.x) / len * 0.05;
+                let side = |p: Point| shape.contains(p) || others.iter().any(|o| o.contains(p));
+                (side(m + nrm) != side(m - nrm)).then_some(*l)
+            })
+        })
+        .collect()
+}
+
+fn overlaps(a: kurbo::Rect, b: kurbo::Rect) -> bool {
+    a.x0 <= b.x1 && b.x0 <= a.x1 && a.y0 <= b.y1 && b.y0 <= a.y1
+}
+
+fn load_svg(path: &Path, bytes: &[u8], opts: &InputOptions) -> Result<Ink> {
+    let tree = io::parse_svg(path, bytes)?;
+    let size = tree.size();
+    let (uw, uh) = (size.width() as f64, size.height() as f64);
+    if opts.resolution == 0 {
+        return Err(Error::Option {
+            name: "--resolution",
+            reason: "must be at least 1 px".into(),
+        });
+    }
+    let scale = opts.resolution as f64 / uw.max(uh);
+    let (pw, ph) = ((uw * scale).ceil() as u64, (uh * scale).ceil() as u64);
+    io::check_canvas(path, pw.max(1), ph.max(1))?;
+    let (pw, ph) = (pw.max(1) as usize, ph.max(1) as usize);
+    let canvas = tiny_skia::Transform::from_scale(scale as f32, scale as f32);
+    let mut shapes = Vec::new();
+    collect_shapes(tree.root(), canvas, &mut shapes);
+    // Colours in order of first appearance: the stacking order.
+    let mut colours: Vec<Color> = Vec::new();
+    for s in &shapes {
+        if !colours.contains(&s.color) {
+            colours.push(s.color);
+        }
+    }
+    let to_user = Affine::scale(1.0 / scale);
+    let layer_sets: Vec<(Color, Vec<&SvgShape>)> = if opts.layers && !opts.invert {
+        (0..colours.len())
+            .map(|k| {
+                let above = &colours[k..];
+                (colours[k], shapes.iter().filter(|s| above.contains(&s.color)).collect())
+            })
+            .collect()
+    } else if shapes.is_empty() && !opts.invert {
+        Vec::new()
+    } else {
+        let colour = if colours.len() == 1 && !opts.invert { colours[0] } else { Color::BLACK };
+        vec![(colour, shapes.iter().collect())]
+    };
+    let mut layers = Vec::new();
+    for (color, set) in layer_sets {
+        let flat: Vec<FlatShape> = set.iter().map(|s| FlatShape::new(s)).collect();
+        let mut inside = scan_inside(pw, ph, &flat);
+        if opts.invert {
+            inside = inside.map(|i| !i);
+        }
+        let segments = union_boundary(&flat);
+        layers.push(InkLayer {
+            color,
+            sdf: Sdf::from_segments(&inside, &segments, to_user),
+        });
+    }
+    Ok(Ink {
+        width: uw,
+        height: uh,
+        layers,
+    })
+}

@@ -1,0 +1,127 @@
+//! Rasters: the [`Grid`] type, the exact Euclidean distance transform, the
+//! signed distance field [`Sdf`] (the seam between every raster mode and the
+//! tracer), and loading of raster and SVG inputs as ink coverage.
+
+pub mod edt;
+pub mod input;
+pub mod sdf;
+
+pub use sdf::Sdf;
+
+/// A dense row-major grid of samples; sample `(x, y)` sits at the pixel
+/// centre `(x + 0.5, y + 0.5)` in pixel coordinates.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Grid<T> {
+    width: usize,
+    height: usize,
+    data: Vec<T>,
+}
+
+impl<T: Copy> Grid<T> {
+    /// A `width`×`height` grid filled with `value`.
+    pub fn new(width: usize, height: usize, value: T) -> Self {
+        Grid {
+            width,
+            height,
+            data: vec![value; width * height],
+        }
+    }
+
+    /// A grid whose sample `(x, y)` is `f(x, y)`.
+    pub fn from_fn(width: usize, height: usize, mut f: impl FnMut(usize, usize) -> T) -> Self {
+        let mut data = Vec::with_capacity(width * height);
+        for y in 0..height {
+            for x in 0..width {
+                data.push(f(x, y));
+            }
+        }
+        Grid {
+            width,
+            height,
+            data,
+        }
+    }
+
+    /// Wraps row-major `data`; `None` when its length is not `width * height`.
+    pub fn from_vec(width: usize, height: usize, data: Vec<T>) -> Option<Self> {
+        (data.len() == width * height).then_some(Grid {
+            width,
+            height,
+            data,
+        })
+    }
+
+    /// Width in samples.
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    /// Height in samples.
+    pub fn height(&self) -> usize {
+        self.height
+    }
+
+    /// The sample at `(x, y)`; panics when out of range (callers index
+    /// within `width`×`height`).
+    #[inline]
+    pub fn get(&self, x: usize, y: usize) -> T {
+        self.data[y * self.width + x]
+    }
+
+    /// The sample at signed `(x, y)`, or `outside` beyond the grid.
+    #[inline]
+    pub fn get_or(&self, x: isize, y: isize, outside: T) -> T {
+        if x < 0 || y < 0 || x as usize >= self.width || y as usize >= self.height {
+            outside
+        } else {
+            self.data[y as usize * self.width + x as usize]
+        }
+    }
+
+    /// Sets the sample at `(x, y)`.
+    #[inline]
+    pub fn set(&mut self, x: usize, y: usize, v: T) {
+        self.data[y * self.width + x] = v;
+    }
+
+    /// Row-major samples.
+    pub fn data(&self) -> &[T] {
+        &self.data
+    }
+
+    /// Row-major samples, mutable.
+    pub fn data_mut(&mut self) -> &mut [T] {
+        &mut self.data
+    }
+
+    /// A grid of `f` applied to every sample.
+    pub fn map<U: Copy>(&self, f: impl Fn(T) -> U) -> Grid<U> {
+        Grid {
+            width: self.width,
+            height: self.height,
+            data: self.data.iter().map(|&v| f(v)).collect(),
+        }
+    }
+}
+
+impl Grid<f32> {
+    /// Bilinear interpolation at a continuous pixel position (pixel centres
+    /// at half-integers), clamped at the border.
+    pub fn sample(&self, x: f64, y: f64) -> f32 {
+        let fx = (x - 0.5).clamp(0.0, (self.width - 1) as f64);
+        let fy = (y - 0.5).clamp(0.0, (self.height - 1) as f64);
+        let x0 = fx.floor() as usize;
+        let y0 = fy.floor() as usize;
+        let x1 = (x0 + 1).min(self.width - 1);
+        let y1 = (y0 + 1).min(self.height - 1);
+        let tx = (fx - x0 as f64) as f32;
+        let ty = (fy - y0 as f64) as f32;
+        let top = self.get(x0, y0) * (1.0 - tx) + self.get(x1, y0) * tx;
+        let bottom = self.get(x0, y1) * (1.0 - tx) + self.get(x1, y1) * tx;
+        top * (1.0 - ty) + bottom * ty
+    }
+}
+
+/// Ink coverage of one layer: 0 (paper) to 1 (ink) per pixel, anti-aliased
+/// edges kept as fractional coverage.
+pub type Coverage = Grid<f32>;

@@ -1,0 +1,362 @@
+//! Level set to closed contours: marching squares on a sampled field.
+//!
+//! Samples sit at pixel centres; a sample is inside when its value is
+//! negative. The grid is padded with outside samples so every contour
+//! closes. A contour vertex lies on a *link* (the segment between two
+//! 4-adjacent samples of opposite sign) at the linear interpolation of the
+//! two values, which is exact for a signed distance field near a straight
+//! boundary. Saddle cells are resolved by the value at the cell centre (the
+//! mean of its four corners), the same way in every cell, so the topology is
+//! consistent. Each crossed link is entered once and left once, so the
+//! segments chain into disjoint closed loops with ink on a fixed side:
+//! outer boundaries have positive signed area, holes negative.
+
+use crate::raster::Grid;
+use kurbo::Point;
+
+/// A link between two 4-adjacent samples, in padded coordinates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Link {
+    /// True for a horizontal link `(x, y)`–`(x + 1, y)`, false for a vertical
+    /// link `(x, y)`–`(x, y + 1)`.
+    pub horizontal: bool,
+    /// Sample column of the first end (may be −1 in the padding).
+    pub x: i32,
+    /// Sample row of the first end (may be −1 in the padding).
+    pub y: i32,
+}
+
+impl Link {
+    /// The two samples the link joins (first, second), unpadded coordinates.
+    pub fn ends(self) -> ((i32, i32), (i32, i32)) {
+        if self.horizontal {
+            ((self.x, self.y), (self.x + 1, self.y))
+        } else {
+            ((self.x, self.y), (self.x, self.y + 1))
+        }
+    }
+
+    /// The point at fraction `t` from the first end to the second, in pixel
+    /// coordinates (pixel centres at half-integers).
+    pub fn point(self, t: f64) -> Point {
+        let (x, y) = (self.x as f64 + 0.5, self.y as f64 + 0.5);
+        if self.horizontal {
+            Point::new(x + t, y)
+        } else {
+            Point::new(x, y + t)
+        }
+    }
+
+    /// The unit direction from the first end to the second.
+    pub fn direction(self) -> kurbo::Vec2 {
+        if self.horizontal {
+            kurbo::Vec2::new(1.0, 0.0)
+        } else {
+            kurbo::Vec2::new(0.0, 1.0)
+        }
+    }
+}
+
+/// One closed contour: the links it crosses, in order, with the crossing
+/// points in pixel coordinates.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Contour {
+    /// The crossed links, in traversal order.
+    pub links: Vec<Link>,
+    /// The crossing point on each link, in pixel coordinates.
+    pub points: Vec<Point>,
+}
+
+impl Contour {
+    /// Signed area (shoelace) in px²: positive for outer boundaries,
+    /// negative for holes.
+    pub fn signed_area(&self) -> f64 {
+        signed_area(&self.points)
+    }
+}
+
+/// Shoelace signed area of a closed polygon.
+pub fn signed_area(points: &[Point]) -> f64 {
+    let n = points.len();
+    let mut a = 0.0;
+    for i in 0..n {
+        let p = points[i];
+        let q = points[(i + 1) % n];
+        a += p.x * q.y - q.x * p.y;
+    }
+    0.5 * a
+}
+
+/// Dense index of links in the padded grid.
+struct LinkIndex {
+    w: i32,
+    h: i32,
+}
+
+impl LinkIndex {
+    // Padded samples run over x in -1..=w, y in -1..=h.
+    fn count(&self) -> usize {
+        let (w, h) = (self.w as usize, self.h as usize);
+        (w + 1) * (h + 2) + (w + 2) * (h + 1)
+    }
+
+    fn id(&self, l: Link) -> usize {
+        let (w, h) = (self.w as usize, self.h as usize);
+        let (x, y) = ((l.x + 1) as usize, (l.y + 1) as usize);
+        if l.horizontal {
+            y * (w + 1) + x
+        } else {
+            (w + 1) * (h + 2) + y * (w + 2) + x
+        }
+    }
+
+    fn link(&self, id: usize) -> Link {
+        let (w, h) = (self.w as usize, self.h as usize);
+        let hcount = (w + 1) * (h + 2);
+        if id < hcount {
+            Link {
+                horizontal: true,
+                x: (id % (w + 1)) as i32 - 1,
+                y: (id / (w + 1)) as i32 - 1,
+            }
+        } else {
+            let id = id - hcount;
+            Link {
+                horizontal: false,
+                x: (id % (w + 2)) as i32 - 1,
+                y: (id / (w + 2)) as i32 - 1,
+            }
+        }
+    }
+}
+
+const NONE: u32 = u32::MAX;
+
+/// Extracts the closed contours of `{v < 0}`. Samples beyond the grid count
+/// as outside, and a crossing into the padding is placed on the canvas
+/// border. Vertices are kept strictly inside their links (at least 0.001 px
+/// from either sample) so no two vertices coincide and no edge has zero
+/// length.
+pub fn extract(values: &Grid<f32>) -> Vec<Contour> {
+    let (w, h) = (values.width() as i32, values.height() as i32);
+    if w == 0 || h == 0 {
+        return Vec::new();
+    }
+    let index = LinkIndex { w, h };
+    let inside = |x: i32, y: i32| values.get_or(x as isize, y as isize, 1.0) < 0.0;
+    let mut next = vec![NONE; index.count()];
+    // Cells are indexed by their top-left sample (x, y), x in -1..w, y in -1..h.
+    for y in -1..h {
+        for x in -1..w {
+            let a = inside(x, y);
+            let b = inside(x + 1, y);
+            let c = inside(x + 1, y + 1);
+            let d = inside(x, y + 1);
+            let case = (a as u8) | (b as u8) << 1 | (c as u8) << 2 | (d as u8) << 3;
+            if case == 0 || case == 15 {
+                continue;
+            }
+            // Cell edges in clockwise order (y down): top a→b, right b→c,
+            // bottom c→d, left d→a.
+            let edges = [
+                Link { horizontal: true, x, y },
+                Link { horizontal: false, x: x + 1, y },
+                Link { horizontal: true, x, y: y + 1 },
+                Link { horizontal: false, x, y },
+            ];
+            let corner = [a, b, c, d];
+            let saddle = case == 5 || case == 10;
+            let centre_inside = saddle && {
+                let v = |x: i32, y: i32| values.get_or(x as isize, y as isize, 1.0);
+                (v(x, y) + v(x + 1, y) + v(x + 1, y + 1) + v(x, y + 1)) < 0.0
+            };
+            // A segment runs from an edge crossed inside→outside (clockwise)
+            // to the out→in edge that bounds the same region of the cell.
+            for e in 0..4 {
+                let (from, to) = (corner[e], corner[(e + 1) % 4]);
+                if !(from && !to) {
+                    continue;
+                }
+                let partner = if saddle {
+                    if centre_inside {
+                        (e + 1) % 4
+                    } else {
+                        (e + 3) % 4
+                    }
+                } else {
+                    // The single out→in edge of the cell.
+                    (0..4)
+                        .find(|&k| !corner[k] && corner[(k + 1) % 4])
+                        .unwrap_or(e)
+                };
+                next[index.id(edges[e])] = index.id(edges[partner]) as u32;
+            }
+        }
+    }
+    let mut contours = Vec::new();
+    let mut seen = vec![false; next.len()];
+    for start in 0..next.len() {
+        if next[start] == NONE || seen[start] {
+            continue;
+        }
+        let mut links = Vec::new();
+        let mut cur = start;
+        while !seen[cur] && next[cur] != NONE {
+            seen[cur] = true;
+            links.push(index.link(cur));
+            cur = next[cur] as usize;
+        }
+        let points = links.iter().map(|&l| crossing(values, l)).collect();
+        contours.push(Contour { links, points });
+    }
+    contours
+}
+
+/// The crossing point of the zero level on link `l` by linear interpolation,
+/// clamped into the link's interior; crossings into the padding lie on the
+/// canvas border.
+pub fn crossing(values: &Grid<f32>, l: Link) -> Point {
+    let ((x0, y0), (x1, y1)) = l.ends();
+    let w = values.width() as i32;
+    let h = values.height() as i32;
+    let outside = |x: i32, y: i32| x < 0 || y < 0 || x >= w || y >= h;
+    let t = if outside(x0, y0) || outside(x1, y1) {
+        0.5
+    } else {
+        let v0 = values.get(x0 as usize, y0 as usize) as f64;
+        let v1 = values.get(x1 as usize, y1 as usize) as f64;
+        clamp_t(v0 / (v0 - v1))
+    };
+    l.point(t)
+}
+
+/// Keeps a link parameter strictly inside the link.
+pub fn clamp_t(t: f64) -> f64 {
+    if t.is_finite() {
+        t.clamp(0.001, 0.999)
+    } else {
+        0.5
+    }
+}
+
+/// Point-in-polygon by the even-odd ray rule.
+pub fn contains(poly: &[Point], p: Point) -> bool {
+    let n = poly.len();
+    let mut inside = false;
+    let mut j = n.wrapping_sub(1);
+    for i in 0..n {
+        let (a, b) = (poly[i], poly[j]);
+        if (a.y > p.y) != (b.y > p.y) && p.x < (b.x - a.x) * (p.y - a.y) / (b.y - a.y) + a.x {
+            inside = !inside;
+        }
+        j = i;
+    }
+    inside
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn field(w: usize, h: usize, f: impl Fn(f64, f64) -> f64) -> Grid<f32> {
+        Grid::from_fn(w, h, |x, y| f(x as f64 + 0.5, y as f64 + 0.5) as f32)
+    }
+
+    fn check_clean(c: &Contour) {
+        let n = c.points.len();
+        assert!(n >= 3);
+        for i in 0..n {
+            let d = (c.points[i] - c.points[(i + 1) % n]).hypot();
+            assert!(d > 1e-4, "zero-length edge at {i}");
+        }
+        let mut links = c.links.clone();
+        links.sort();
+        links.dedup();
+        assert_eq!(links.len(), n, "duplicate vertex");
+    }
+
+    #[test]
+    fn disc_is_one_outer_loop() {
+        let g = field(20, 20, |x, y| ((x - 10.0).hypot(y - 10.0)) - 6.0);
+        let cs = extract(&g);
+        assert_eq!(cs.len(), 1);
+        check_clean(&cs[0]);
+        let a = cs[0].signed_area();
+        assert!(a > 0.0);
+        assert!((a - std::f64::consts::PI * 36.0).abs() < 2.0, "{a}");
+        for p in &cs[0].points {
+            assert!(((p.x - 10.0).hypot(p.y - 10.0) - 6.0).abs() < 0.05);
+        }
+    }
+
+    #[test]
+    fn ring_has_outer_and_hole() {
+        let g = field(24, 24, |x, y| {
+            let r = (x - 12.0).hypot(y - 12.0);
+            (r - 9.0).max(4.0 - r)
+        });
+        let mut cs = extract(&g);
+        assert_eq!(cs.len(), 2);
+        cs.sort_by(|a, b| b.signed_area().total_cmp(&a.signed_area()));
+        assert!(cs[0].signed_area() > 0.0);
+        assert!(cs[1].signed_area() < 0.0);
+        assert!(contains(&cs[0].points, cs[1].points[0]));
+        cs.iter().for_each(check_clean);
+    }
+
+    #[test]
+    fn two_touching_squares_by_a_corner() {
+        // Two squares meeting diagonally at one sample corner: the saddle
+        // rule must give the same answer wherever it is applied.
+        let mut g = Grid::new(6, 6, 1.0f32);
+        for (x, y) in [(1, 1), (2, 1), (1, 2), (2, 2), (3, 3), (4, 3), (3, 4), (4, 4)] {
+            g.set(x, y, -1.0);
+        }
+        let cs = extract(&g);
+        // Cell centre between (2,2) and (3,3) averages to 0 → outside: apart.
+        assert_eq!(cs.len(), 2);
+        assert!(cs.iter().all(|c| c.signed_area() > 0.0));
+        // Make the diagonal join: centre inside.
+        g.set(2, 2, -3.0);
+        let cs = extract(&g);
+        assert_eq!(cs.len(), 1);
+        cs.iter().for_each(check_clean);
+    }
+
+    #[test]
+    fn checkerboard_of_saddles() {
+        let g = Grid::from_fn(8, 8, |x, y| if (x + y) % 2 == 0 { -1.0f32 } else { 1.0 });
+        let cs = extract(&g);
+        // Centres average to 0 → outside: every inside sample is its own island.
+        assert_eq!(cs.len(), 32);
+        assert!(cs.iter().all(|c| c.signed_area() > 0.0 && c.points.len() == 4));
+        let g2 = g.map(|v| if v < 0.0 { -1.5 } else { 1.0 });
+        let cs2 = extract(&g2);
+        // Centres inside → all inside samples join into one region with holes.
+        let outers = cs2.iter().filter(|c| c.signed_area() > 0.0).count();
+        assert_eq!(outers, 1);
+        assert!(cs2.iter().filter(|c| c.signed_area() < 0.0).count() > 0);
+    }
+
+    #[test]
+    fn one_pixel_line_survives() {
+        let g = field(20, 9, |_, y| (y - 4.5).abs() - 0.5);
+        let cs = extract(&g);
+        assert_eq!(cs.len(), 1);
+        let c = &cs[0];
+        check_clean(c);
+        let ys: Vec<f64> = c.points.iter().map(|p| p.y).collect();
+        let (lo, hi) = ys.iter().fold((f64::MAX, f64::MIN), |(a, b), &y| (a.min(y), b.max(y)));
+        assert!((hi - lo - 1.0).abs() < 0.01, "{lo} {hi}");
+    }
+
+    #[test]
+    fn ink_touching_the_border_closes_on_it() {
+        let g = Grid::new(3, 2, -1.0f32);
+        let cs = extract(&g);
+        assert_eq!(cs.len(), 1);
+        // The loop runs along the canvas border and cuts each canvas corner
+        // by a half-pixel triangle: 6 − 4 · ⅛ px².
+        assert!((cs[0].signed_area() - 5.5).abs() < 1e-9);
+    }
+}

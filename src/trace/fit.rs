@@ -1,0 +1,425 @@
+//! Contours to cubic Béziers with kurbo's curve fitter.
+//!
+//! A contour (the marching-squares polygon of an SDF's zero level set) is
+//! cut at its corners and each piece is presented to kurbo as a
+//! [`ParamCurveFit`] source: positions along the polygon by arc length, and
+//! tangents perpendicular to the SDF gradient, which is smooth where the
+//! outline is, so pieces join with G1 continuity. `fit_to_bezpath_opt`
+//! then finds the fewest cubics within the tolerance. Corners are the
+//! vertices where the outline turns sharply within a pixel-scale window;
+//! the curves meet there at an angle, so sharp corners stay sharp.
+
+use crate::raster::Sdf;
+use kurbo::{
+    fit_to_bezpath_opt, Affine, BezPath, CubicBez, CurveFitSample, ParamCurve, ParamCurveArclen, ParamCurveFit, PathSeg, Point, Vec2,
+};
+use std::ops::Range;
+
+/// Half-width in pixels of the window over which turning is measured when
+/// looking for corners.
+const CORNER_WINDOW: f64 = 1.25;
+
+/// Turning (radians) above which a vertex is a corner: 55°.
+const CORNER_ANGLE: f64 = 55.0 * std::f64::consts::PI / 180.0;
+
+/// One piece of a closed contour between corners (or the whole contour),
+/// parameterized by normalized arc length.
+struct Piece<'a> {
+    pts: Vec<Point>,
+    /// Cumulative arc length at each vertex.
+    cum: Vec<f64>,
+    sdf: &'a Sdf,
+    corner_start: bool,
+    corner_end: bool,
+    /// The fitter sees coordinates relative to this point: kurbo's moment
+    /// integrals lose precision far from the origin.
+    origin: Vec2,
+}
+
+impl<'a> Piece<'a> {
+    fn new(pts: Vec<Point>, sdf: &'a Sdf, corner_start: bool, corner_end: bool) -> Self {
+        let mut cum = Vec::with_capacity(pts.len());
+        let mut s = 0.0;
+        cum.push(0.0);
+        for w in pts.windows(2) {
+            s += (w[1] - w[0]).hypot();
+            cum.push(s);
+        }
+        let origin = pts.first().map(|p| p.to_vec2()).unwrap_or_default();
+        Piece {
+            pts,
+            cum,
+            sdf,
+            corner_start,
+            corner_end,
+            origin,
+        }
+    }
+
+    fn length(&self) -> f64 {
+        *self.cum.last().unwrap_or(&0.0)
+    }
+
+    /// Segment index and position at arc length `s`.
+    fn locate(&self, s: f64) -> (usize, Point) {
+        let n = self.pts.len();
+        let s = s.clamp(0.0, self.length());
+        let i = match self.cum.binary_search_by(|c| c.total_cmp(&s)) {
+            Ok(i) => i.min(n - 2),
+            Err(i) => i.saturating_sub(1).min(n - 2),
+        };
+        let seg = self.cum[i + 1] - self.cum[i];
+        let t = if seg > 0.0 { (s - self.cum[i]) / seg } else { 0.0 };
+        (i, self.pts[i].lerp(self.pts[i + 1], t))
+    }
+
+    fn seg_dir(&self, i: usize) -> Vec2 {
+        let d = self.pts[i + 1] - self.pts[i];
+        let l = d.hypot();
+        if l > 0.0 {
+            d / l
+        } else {
+            Vec2::new(1.0, 0.0)
+        }
+    }
+
+    /// Chord direction over about a pixel from arc length `s` towards the
+    /// interior of the piece (`forward` from the start, else backwards).
+    fn chord_dir(&self, s: f64, forward: bool) -> Vec2 {
+        let len = self.length();
+        let reach = 1.0f64.min(len);
+        let (a, b) = if forward {
+            (self.locate(s).1, self.locate(s + reach).1)
+        } else {
+            (self.locate(s - reach).1, self.locate(s).1)
+        };
+        let d = b - a;
+        let l = d.hypot();
+        if l > 1e-9 {
+            d / l
+        } else {
+            self.seg_dir(0)
+        }
+    }
+}
+
+impl ParamCurveFit for Piece<'_> {
+    fn sample_pt_tangent(&self, t: f64, sign: f64) -> CurveFitSample {
+        let s = t * self.length();
+        let (i, p) = self.locate(s);
+        let travel = self.seg_dir(i);
+        let at_start = t <= 0.0;
+        let at_end = t >= 1.0;
+        let tangent = if (at_start && self.corner_start) || (at_end && self.corner_end) {
+            // At a corner the gradient is undefined: use the side's chord.
+            self.chord_dir(s, at_start || sign > 0.0 && !at_end)
+        } else {
+            let g = self.sdf.gradient(p);
+            let perp = Vec2::new(-g.y, g.x);
+            let l = perp.hypot();
+            if l > 1e-6 {
+                let d = perp / l;
+                if d.dot(travel) < 0.0 {
+                    -d
+                } else {
+                    d
+                }
+            } else {
+                travel
+            }
+        };
+        CurveFitSample {
+            p: p - self.origin,
+            tangent,
+        }
+    }
+
+    fn sample_pt_deriv(&self, t: f64) -> (Point, Vec2) {
+        let s = t * self.length();
+        let (i, p) = self.locate(s);
+        (p - self.origin, self.seg_dir(i) * self.length())
+    }
+
+    fn break_cusp(&self, _range: Range<f64>) -> Option<f64> {
+        // Corners were cut before fitting.
+        None
+    }
+}
+
+/// Indices of the corner vertices of a closed polygon: turning by more
+/// than [`CORNER_ANGLE`] within ±[`CORNER_WINDOW`] px, the sharpest vertex
+/// of each such stretch.
+pub fn corners(pts: &[Point]) -> Vec<usize> {
+    let n = pts.len();
+    if n < 4 {
+        return Vec::new();
+    }
+    let mut cum = Vec::with_capacity(n + 1);
+    let mut s = 0.0;
+    cum.push(0.0);
+    for i in 0..n {
+        s += (pts[(i + 1) % n] - pts[i]).hypot();
+        cum.push(s);
+    }
+    let total = s;
+    if total < 4.0 * CORNER_WINDOW {
+        return Vec::new();
+    }
+    // Point at arc length s along the closed polygon (wrapping).
+    let at = |s: f64| -> Point {
+        let s = s.rem_euclid(total);
+        let i = match cum.binary_search_by(|c: &f64| c.total_cmp(&s)) {
+            Ok(i) => i.min(n - 1),
+            Err(i) => i.saturating_sub(1).min(n - 1),
+        };
+        let seg = cum[i + 1] - cum[i];
+        let t = if seg > 0.0 { (s - cum[i]) / seg } else { 0.0 };
+        pts[i].lerp(pts[(i + 1) % n], t)
+    };
+    let turn: Vec<f64> = (0..n)
+        .map(|i| {
+            let p = pts[i];
+            let a = p - at(cum[i] - CORNER_WINDOW);
+            let b = at(cum[i] + CORNER_WINDOW) - p;
+            a.cross(b).atan2(a.dot(b)).abs()
+        })
+        .collect();
+    let mut out = Vec::new();
+    for i in 0..n {
+        if turn[i] < CORNER_ANGLE {
+            continue;
+        }
+        // Local maximum within the window (ties broken by index).
+        let mut is_max = true;
+        let mut j = (i + 1) % n;
+        while j != i && (cum[j] - cum[i]).rem_euclid(total) <= CORNER_WINDOW {
+            if turn[j] > turn[i] {
+                is_max = false;
+            }
+            j = (j + 1) % n;
+        }
+        let mut j = (i + n - 1) % n;
+        while j != i && (cum[i] - cum[j]).rem_euclid(total) <= CORNER_WINDOW {
+            if turn[j] >= turn[i] {
+                is_max = false;
+            }
+            j = (j + n - 1) % n;
+        }
+        if is_max {
+            out.push(i);
+        }
+    }
+    out
+}
+
+/// Fits a closed contour (pixel coordinates) with cubic Béziers within
+/// `accuracy` px, appending a closed subpath to `out`.
+pub fn fit_contour(pts: &[Point], sdf: &Sdf, accuracy: f64, out: &mut BezPath) {
+    let n = pts.len();
+    if n < 3 {
+        return;
+    }
+    let cs = corners(pts);
+    let mut pieces: Vec<Piece> = Vec::new();
+    if cs.is_empty() {
+        // A smooth loop is fitted as two open halves (kurbo's fitter needs
+        // distinct end points); the tangents at the joins come from the SDF,
+        // so the halves meet with G1 continuity.
+        let h = n / 2;
+        let mut second: Vec<Point> = pts[h..].to_vec();
+        second.push(pts[0]);
+        pieces.push(Piece::new(pts[..=h].to_vec(), sdf, false, false));
+        pieces.push(Piece::new(second, sdf, false, false));
+    } else {
+        for k in 0..cs.len() {
+            let a = cs[k];
+            let b = cs[(k + 1) % cs.len()];
+            let mut seg = Vec::new();
+            let mut i = a;
+            loop {
+                seg.push(pts[i]);
+                if i == b && seg.len() > 1 {
+                    break;
+                }
+                i = (i + 1) % n;
+                if i == b {
+                    seg.push(pts[i]);
+                    break;
+                }
+            }
+            pieces.push(Piece::new(seg, sdf, true, true));
+        }
+    }
+    let mut first = true;
+    let mut cubics = Vec::new();
+    for piece in pieces.iter().flat_map(split_by_turning) {
+        if piece.length() > 1e-9 {
+            fit_piece(&piece, accuracy, 0, &mut cubics);
+        }
+    }
+    for c in cubics {
+        if first {
+            out.move_to(c.p0);
+            first = false;
+        }
+        if is_line(&c) {
+            out.line_to(c.p3);
+        } else {
+            out.curve_to(c.p1, c.p2, c.p3);
+        }
+    }
+    if !first {
+        out.close_path();
+    }
+}
+
+fn is_line(c: &CubicBez) -> bool {
+    c.p1 == c.p0.lerp(c.p3, 1.0 / 3.0) && c.p2 == c.p0.lerp(c.p3, 2.0 / 3.0)
+}
+
+fn line_cubic(a: Point, b: Point) -> CubicBez {
+    CubicBez::new(a, a.lerp(b, 1.0 / 3.0), a.lerp(b, 2.0 / 3.0), b)
+}
+
+/// Largest turning (radians) of one piece handed to the fitter: a quarter
+/// turn, which one cubic can follow closely. Longer turns make kurbo's
+/// optimizer fall back to slow arc-length error measures.
+const MAX_PIECE_TURN: f64 = std::f64::consts::FRAC_PI_2;
+
+/// Splits a piece where its accumulated turning exceeds [`MAX_PIECE_TURN`];
+/// the cuts keep SDF tangents on both sides, so they are G1 joins.
+fn split_by_turning<'a>(piece: &Piece<'a>) -> Vec<Piece<'a>> {
+    let n = piece.pts.len();
+    if n < 4 {
+        return vec![Piece::new(piece.pts.clone(), piece.sdf, piece.corner_start, piece.corner_end)];
+    }
+    // Turning is accumulated between chords of about 3 px, which follow the
+    // outline's shape and not the sub-pixel wobble of its vertices.
+    const STEP: f64 = 3.0;
+    let mut acc = vec![0.0; n];
+    let mut anchor = 0usize;
+    let mut prev_dir: Option<f64> = None;
+    let mut total = 0.0;
+    for i in 1..n {
+        if piece.cum[i] - piece.cum[anchor] >= STEP || i == n - 1 {
+            let d = (piece.pts[i] - piece.pts[anchor]).atan2();
+            if let Some(p) = prev_dir {
+                let mut t = d - p;
+                while t > std::f64::consts::PI {
+                    t -= std::f64::consts::TAU;
+                }
+                while t < -std::f64::consts::PI {
+                    t += std::f64::consts::TAU;
+                }
+                total += t.abs();
+            }
+            prev_dir = Some(d);
+            anchor = i;
+        }
+        acc[i] = total;
+    }
+    // Equal shares of turning, each at most a quarter turn.
+    let parts = (acc[n - 1] / MAX_PIECE_TURN).ceil().max(1.0) as usize;
+    let mut cuts = vec![0usize];
+    for k in 1..parts {
+        let target = acc[n - 1] * k as f64 / parts as f64;
+        let i = acc.partition_point(|&a| a < target).clamp(1, n - 2);
+        if i > cuts[cuts.len() - 1] + 1 && i + 1 < n - 1 {
+            cuts.push(i);
+        }
+    }
+    cuts.push(n - 1);
+    cuts.windows(2)
+        .map(|w| {
+            Piece::new(
+                piece.pts[w[0]..=w[1]].to_vec(),
+                piece.sdf,
+                w[0] == 0 && piece.corner_start,
+                w[1] == n - 1 && piece.corner_end,
+            )
+        })
+        .collect()
+}
+
+/// Extra distance (px) allowed between a fitted curve and the level set
+/// beyond the fitting accuracy, for the bilinear interpolation of the SDF.
+pub const CHECK_SLACK: f64 = 0.04;
+
+/// Fits one piece, checking every cubic against the SDF itself: kurbo
+/// measures the error at a handful of samples only, so a cubic that strays
+/// from the level set between them (or loops away and back) is rejected and
+/// the piece split at its middle vertex and refitted. As a last resort the
+/// polygon itself is kept, which is within tolerance by construction.
+fn fit_piece(piece: &Piece, accuracy: f64, depth: u32, out: &mut Vec<CubicBez>) {
+    let n = piece.pts.len();
+    let a = piece.pts[0];
+    let b = piece.pts[n - 1];
+    let chord = kurbo::Line::new(a, b);
+    if a != b
+        && piece
+            .pts
+            .iter()
+            .all(|&p| crate::raster::sdf::point_segment_distance(p, chord) <= accuracy)
+    {
+        out.push(line_cubic(a, b));
+        return;
+    }
+    let fitted = Affine::translate(piece.origin) * fit_to_bezpath_opt(piece, accuracy);
+    let mut cubics = Vec::new();
+    let mut ok = true;
+    let mut total = 0.0;
+    for seg in fitted.segments() {
+        let c = match seg {
+            PathSeg::Cubic(c) => c,
+            PathSeg::Line(l) => line_cubic(l.p0, l.p1),
+            PathSeg::Quad(q) => q.raise(),
+        };
+        total += c.arclen(0.01);
+        ok &= (1..16).all(|k| piece.sdf.value(c.eval(k as f64 / 16.0)).abs() <= accuracy + CHECK_SLACK);
+        cubics.push(c);
+    }
+    ok &= !cubics.is_empty() && total <= 1.5 * piece.length() + 1.0;
+    if ok {
+        out.extend(cubics);
+        return;
+    }
+    if depth < 8 && n >= 4 {
+        let mid = n / 2;
+        let left = Piece::new(piece.pts[..=mid].to_vec(), piece.sdf, piece.corner_start, false);
+        let right = Piece::new(piece.pts[mid..].to_vec(), piece.sdf, false, piece.corner_end);
+        fit_piece(&left, accuracy, depth + 1, out);
+        fit_piece(&right, accuracy, depth + 1, out);
+        return;
+    }
+    for w in piece.pts.windows(2) {
+        if w[0] != w[1] {
+            out.push(line_cubic(w[0], w[1]));
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::raster::Grid;
+    use crate::trace::contour;
+    use kurbo::Affine;
+
+    pub(crate) fn disc_sdf(size: usize, cx: f64, cy: f64, r: f64) -> Sdf {
+        Sdf {
+            dist: Grid::from_fn(size, size, |x, y| ((x as f64 + 0.5 - cx).hypot(y as f64 + 0.5 - cy) - r) as f32),
+            to_user: Affine::IDENTITY,
+        }
+    }
+
+    #[test]
+    fn large_disc_needs_few_cubics() {
+        let sdf = disc_sdf(660, 330.0, 330.0, 307.0);
+        let cs = contour::extract(&sdf.dist);
+        assert_eq!(cs.len(), 1);
+        let mut path = BezPath::new();
+        fit_contour(&cs[0].points, &sdf, 0.25, &mut path);
+        let n = crate::svg_out::count_segments(&path);
+        assert!(n <= 8, "{n} segments");
+    }
+}
