@@ -587,7 +587,8 @@ fn glyph_g() -> BezPath {
         (246.0, 346.0),
         (272.0, 346.0),
     ]));
-    g.extend(stroke(&link, &pen, Cap::Round, Cap::Round));
+    let link_w = |s: f64, t: Vec2| 0.72 * pen(s, t);
+    g.extend(stroke(&link, &link_w, Cap::Round, Cap::Round));
     // Lower loop.
     g.extend(ring(&ellipse_spine((262.0, 412.0), 94.0, 66.0), &pen));
     g
@@ -602,40 +603,47 @@ fn glyph_s() -> BezPath {
         (222.0, 163.0),
         (200.0, 184.0),
         (200.0, 214.0),
-        (200.0, 246.0),
-        (228.0, 262.0),
-        (262.0, 276.0),
-        (296.0, 290.0),
-        (324.0, 306.0),
-        (324.0, 342.0),
-        (324.0, 378.0),
-        (294.0, 400.0),
-        (256.0, 400.0),
-        (218.0, 400.0),
+        (200.0, 248.0),
+        (226.0, 266.0),
+        (257.0, 280.0),
+        (288.0, 294.0),
+        (314.0, 312.0),
+        (314.0, 346.0),
+        (314.0, 376.0),
+        (292.0, 397.0),
+        (256.0, 397.0),
+        (220.0, 397.0),
         (192.0, 378.0),
-        (190.0, 346.0),
+        (192.0, 346.0),
     ]);
     let sp = Spine::from_path(&spine);
     let hw = |s: f64, t: Vec2| {
-        let spine_boost = (-((s - 0.5) / 0.14).powi(2)).exp();
+        let spine_boost = 0.9 * (-((s - 0.5) / 0.15).powi(2)).exp();
         let a = t.y.atan2(t.x) - TILT;
-        let k = a.sin().abs().powf(1.6).max(spine_boost * 0.9);
-        0.5 * (THIN + (THICK - THIN) * k) * (0.55 + 0.45 * ((1.0 - (2.0 * s - 1.0).abs()) / 0.12).min(1.0))
+        let dir = a.sin().abs().powf(1.6);
+        let k = 1.0 - (1.0 - dir) * (1.0 - spine_boost);
+        let e = smoothstep((1.0 - (2.0 * s - 1.0).abs()) / 0.3);
+        0.5 * (THIN + (THICK - THIN) * k) * (0.6 + 0.4 * e)
     };
     let mut g = stroke(&sp, &hw, Cap::Butt, Cap::Butt);
-    // Vertical beak serifs at both terminals (point-symmetric pair).
-    let mut beak = BezPath::new();
-    beak.move_to((340.0, 168.0));
-    beak.line_to((346.0, 168.0));
-    beak.line_to((346.0, 220.0));
-    beak.line_to((310.0, 220.0));
-    beak.curve_to((326.0, 208.0), (338.0, 196.0), (340.0, 168.0));
-    beak.close_path();
-    let beak = orient(beak, true);
-    g.extend(beak.clone());
-    // Bottom-left: rotate 180 degrees about the letter's centre.
-    g.extend(place(&beak, Affine::rotate_about(PI, Point::new(266.0, 282.0))));
+    // Vertical serifs at both terminals (a point-symmetric pair): a bar
+    // flush with the outer edge of the flat terminal, bracketed below.
+    let mut bar = BezPath::new();
+    bar.move_to((327.0, 164.0));
+    bar.line_to((335.0, 164.0));
+    bar.line_to((335.0, 214.0));
+    bar.line_to((318.0, 214.0));
+    bar.curve_to((324.0, 206.0), (327.0, 194.0), (327.0, 164.0));
+    bar.close_path();
+    let bar = orient(bar, true);
+    g.extend(place(&bar, Affine::rotate_about(PI, Point::new(257.0, 280.0))));
+    g.extend(bar);
     g
+}
+
+fn smoothstep(x: f64) -> f64 {
+    let x = x.clamp(0.0, 1.0);
+    x * x * (3.0 - 2.0 * x)
 }
 
 fn glyph_art(g: BezPath) -> Art {
@@ -671,18 +679,11 @@ fn scroll_half() -> Vec<BezPath> {
     out.push(scroll(
         main_start, main_dir, 70.0, 80.0, big, &main_w, Cap::Round, 6.0,
     ));
+    let (q, tq) = big.start();
+    let lead = CubicBez::new(main_start, main_start + unit(main_dir) * 70.0, q - tq * 80.0, q);
+    let on_main = |u: f64| (lead.eval(u), unit(lead.deriv().eval(u).to_vec2()));
     // Secondary scroll branching off below, curling down.
-    let (bq, btan) = {
-        let (q, tq) = big.start();
-        let c = CubicBez::new(
-            main_start,
-            main_start + unit(main_dir) * 70.0,
-            q - tq * 80.0,
-            q,
-        );
-        let u = 0.42;
-        (c.eval(u), unit(c.deriv().eval(u).to_vec2()))
-    };
+    let (bq, btan) = on_main(0.42);
     let small = Volute {
         c: Point::new(150.0, 118.0),
         r0: 38.0,
@@ -694,19 +695,9 @@ fn scroll_half() -> Vec<BezPath> {
     let small_w = swell(2.0, 10.0, 2.4, 0.32);
     out.push(scroll(bq, btan, 30.0, 40.0, small, &small_w, Cap::Round, 4.6));
     // Upper tendril: from the main stroke up and curling left.
-    let (tq0, ttan) = {
-        let (q, tq) = big.start();
-        let c = CubicBez::new(
-            main_start,
-            main_start + unit(main_dir) * 70.0,
-            q - tq * 80.0,
-            q,
-        );
-        let u = 0.2;
-        (c.eval(u), unit(c.deriv().eval(u).to_vec2()))
-    };
+    let (tq0, ttan) = on_main(0.3);
     let tendril = Volute {
-        c: Point::new(86.0, -70.0),
+        c: Point::new(104.0, -80.0),
         r0: 26.0,
         th0: 0.0,
         dir: -1.0,
@@ -714,75 +705,62 @@ fn scroll_half() -> Vec<BezPath> {
         ratio: 0.28,
     };
     let tw = swell(1.5, 7.5, 2.0, 0.3);
-    out.push(scroll(
-        tq0,
-        ttan,
-        40.0,
-        50.0,
-        tendril,
-        &tw,
-        Cap::Round,
-        3.6,
-    ));
-    // Leaves at the forks.
+    out.push(scroll(tq0, ttan, 36.0, 50.0, tendril, &tw, Cap::Round, 3.6));
+    // Leaves sprouting from the strokes.
+    let (b1, _) = on_main(0.64);
+    out.push(leaf(b1, b1 + Vec2::new(44.0, 40.0), 0.12, 18.0, 1.8));
     out.push(leaf(
-        Point::new(132.0, 60.0),
-        Point::new(196.0, 52.0),
-        -0.12,
-        22.0,
-        2.2,
-    ));
-    out.push(leaf(
-        Point::new(60.0, 40.0),
-        Point::new(40.0, -34.0),
-        0.14,
-        18.0,
-        1.8,
-    ));
-    out.push(leaf(
-        Point::new(236.0, 40.0),
-        Point::new(300.0, 82.0),
-        0.15,
+        Point::new(226.0, 24.0),
+        Point::new(296.0, 50.0),
+        0.13,
         20.0,
         2.0,
     ));
-    // Pearl trail above the big volute.
-    for (i, r) in [5.5, 4.2, 3.0].iter().enumerate() {
-        let a = -2.25 + 0.3 * i as f64;
-        out.push(dot(polar(Point::new(214.0, -64.0), 112.0, a), *r));
+    let (b2, _) = on_main(0.12);
+    out.push(leaf(b2, b2 + Vec2::new(34.0, 46.0), -0.1, 16.0, 1.6));
+    // Pearl trail around the big volute.
+    for (i, r) in [5.0, 4.0, 3.0].iter().enumerate() {
+        let a = -2.55 + 0.3 * i as f64;
+        out.push(dot(polar(big.c, 106.0, a), *r));
     }
+    out
+}
+
+/// The full filigree (both halves and the central palmette) in a 768x512
+/// box.
+fn scroll_composition() -> Vec<BezPath> {
+    let mut out = Vec::new();
+    let origin = Affine::translate((384.0, 272.0));
+    let mirror = Affine::translate((384.0, 272.0)) * Affine::scale_non_uniform(-1.0, 1.0);
+    let flip = Affine::translate((768.0, 0.0)) * Affine::scale_non_uniform(-1.0, 1.0);
+    for p in scroll_half() {
+        out.push(place(&p, origin));
+        out.push(place(&p, mirror));
+    }
+    // Central motif: palmette of three leaves, a pendant and buds.
+    let c = Point::new(384.0, 318.0);
+    out.push(leaf(c, Point::new(384.0, 150.0), 0.0, 46.0, 3.0));
+    let side = leaf(
+        Point::new(378.0, 316.0),
+        Point::new(334.0, 206.0),
+        -0.12,
+        24.0,
+        2.0,
+    );
+    out.push(place(&side, flip));
+    out.push(side);
+    out.push(dot(Point::new(384.0, 132.0), 7.0));
+    out.push(dot(Point::new(384.0, 114.0), 4.0));
+    out.push(leaf(c + Vec2::new(0.0, 4.0), Point::new(384.0, 392.0), 0.0, 20.0, 0.0));
+    out.push(dot(Point::new(384.0, 406.0), 4.5));
     out
 }
 
 fn ornament_scroll() -> Art {
     let mut art = Art::new(768, 512);
-    let origin = Affine::translate((384.0, 272.0));
-    let mirror = Affine::translate((384.0, 272.0)) * Affine::scale_non_uniform(-1.0, 1.0);
-    for p in scroll_half() {
-        art.add("#000", place(&p, origin));
-        art.add("#000", place(&p, mirror));
+    for p in scroll_composition() {
+        art.add("#000", p);
     }
-    // Central motif: palmette of three leaves and a bud.
-    let c = Point::new(384.0, 318.0);
-    art.add("#000", leaf(c, Point::new(384.0, 150.0), 0.0, 46.0, 3.0));
-    art.add(
-        "#000",
-        leaf(Point::new(378.0, 316.0), Point::new(318.0, 210.0), -0.16, 26.0, 2.2),
-    );
-    art.add(
-        "#000",
-        place(
-            &leaf(Point::new(378.0, 316.0), Point::new(318.0, 210.0), -0.16, 26.0, 2.2),
-            Affine::translate((768.0, 0.0)) * Affine::scale_non_uniform(-1.0, 1.0),
-        ),
-    );
-    art.add("#000", dot(Point::new(384.0, 132.0), 7.0));
-    art.add("#000", dot(Point::new(384.0, 114.0), 4.0));
-    art.add(
-        "#000",
-        leaf(Point::new(384.0, 322.0), Point::new(384.0, 392.0), 0.0, 20.0, 0.0),
-    );
-    art.add("#000", dot(Point::new(384.0, 406.0), 4.5));
     art
 }
 
@@ -1054,56 +1032,65 @@ fn two_colour() -> Art {
     art
 }
 
-/// A running border vine along the x axis from 0 to `len`: a sine spine
-/// with curls alternating above and below.
-fn vine(len: f64, period: f64, amp: f64) -> Vec<BezPath> {
+/// A running border vine along the x axis: `n` periods of a gentle wave
+/// with a curl in every hollow, alternating sides.
+fn vine(n: usize, period: f64, amp: f64) -> Vec<BezPath> {
     let mut out = Vec::new();
-    let w = move |u: f64| Point::new(u * len, amp * (u * len / period * TAU).sin());
-    let d = move |u: f64| {
-        Vec2::new(
-            len,
-            amp * (u * len / period * TAU).cos() * len / period * TAU,
+    let len = n as f64 * period;
+    let k = TAU / period;
+    let spine: Piece = Box::new(move |u| {
+        let x = u * len;
+        (
+            Point::new(x, amp * (k * x).sin()),
+            Vec2::new(len, amp * k * (k * x).cos() * len),
         )
+    });
+    let hw = swell(0.0, 6.0, 0.0, 0.5);
+    let hw = move |s: f64, t: Vec2| hw(s, t).max(0.0).min(3.0) * (s * 40.0).min(1.0);
+    out.push(stroke(
+        &Spine::new(vec![spine]),
+        &hw,
+        Cap::Round,
+        Cap::Round,
+    ));
+    // One curl, above the first trough; the next is its point reflection.
+    let wave = |x: f64| Point::new(x, amp * (k * x).sin());
+    let slope = |x: f64| unit(Vec2::new(1.0, amp * k * (k * x).cos()));
+    let x0 = 0.04 * period;
+    let v = Volute {
+        c: Point::new(0.3 * period, -0.3 * amp),
+        r0: 0.95 * amp,
+        th0: -PI / 2.0,
+        dir: 1.0,
+        turns: 1.15,
+        ratio: 0.3,
     };
-    let spine: Piece = Box::new(move |u| (w(u), d(u)));
-    let hw = |s: f64, _t: Vec2| 0.5 * (3.0 + 3.0 * (s * len / period * TAU * 2.0).cos().abs());
-    out.push(stroke(&Spine::new(vec![spine]), &hw, Cap::Round, Cap::Round));
-    let n = (len / period * 2.0).round() as usize;
+    let sw = swell(1.2, 5.0, 1.6, 0.3);
+    let curl = scroll(
+        wave(x0),
+        slope(x0) + Vec2::new(0.0, -0.9),
+        0.5 * amp,
+        0.6 * amp,
+        v,
+        &sw,
+        Cap::Round,
+        2.6,
+    );
+    let xl = 0.62 * period;
+    let leaf0 = leaf(
+        wave(xl),
+        wave(xl) + Vec2::new(0.16 * period, 0.55 * amp),
+        -0.12,
+        9.0,
+        0.0,
+    );
     for i in 0..n {
-        // Branch just after each zero crossing, curl towards the crest side.
-        let x0 = (i as f64 + 0.1) * period / 2.0;
-        let u = x0 / len;
-        let up = if i % 2 == 0 { -1.0 } else { 1.0 };
-        let p0 = w(u);
-        let t0 = d(u);
-        let vc = Point::new(x0 + period * 0.3, up * -amp * 1.2);
-        let v = Volute {
-            c: vc,
-            r0: amp * 0.95,
-            th0: if up < 0.0 { -PI / 2.0 } else { PI / 2.0 } + PI,
-            dir: up,
-            turns: 1.1,
-            ratio: 0.3,
-        };
-        let _ = (p0, t0);
-        let sw = swell(1.0, 5.0, 1.6, 0.35);
-        out.push(scroll(
-            p0,
-            Vec2::new(1.0, -up * 0.9),
-            amp * 0.5,
-            amp * 0.5,
-            v,
-            &sw,
-            Cap::Round,
-            2.6,
-        ));
-        out.push(leaf(
-            w(u + period * 0.24 / len),
-            w(u + period * 0.24 / len) + Vec2::new(period * 0.16, up * amp * 0.9),
-            0.1 * up,
-            8.0,
-            0.0,
-        ));
+        let base = Affine::translate((i as f64 * period, 0.0));
+        let half = base * Affine::rotate_about(PI, Point::new(0.5 * period, 0.0));
+        for p in [&curl, &leaf0] {
+            out.push(place(p, base));
+            out.push(place(p, half));
+        }
     }
     out
 }
@@ -1125,33 +1112,31 @@ fn ornament_2mp() -> Art {
     art.add("#000", frame(40.0, 10.0));
     art.add("#000", frame(58.0, 3.0));
     art.add("#000", frame(196.0, 3.0));
-    // Vines along the four edges between the frames.
-    let v = vine(900.0, 150.0, 30.0);
-    for k in 0..4 {
-        let rot = Affine::rotate_about(k as f64 * PI / 2.0, Point::new(707.0, 707.0));
-        let a = rot * Affine::translate((257.0, 128.0));
+    // Vines along the four edges, between corner rosettes.
+    let (n, period) = (5, 170.0);
+    let v = vine(n, period, 22.0);
+    for q in 0..4 {
+        let rot = Affine::rotate_about(q as f64 * PI / 2.0, Point::new(707.0, 707.0));
+        let a = rot * Affine::translate((707.0 - 0.5 * n as f64 * period, 127.0));
         for p in &v {
             art.add("#000", place(p, a));
         }
     }
-    // Corner rosettes.
-    for (x, y) in [(128.0, 128.0), (1286.0, 128.0), (128.0, 1286.0), (1286.0, 1286.0)] {
+    for (x, y) in [(127.0, 127.0), (1287.0, 127.0), (127.0, 1287.0), (1287.0, 1287.0)] {
         for p in rosette(Point::new(x, y), 0.26) {
             art.add("#000", p);
         }
     }
-    // Centre rosette with scroll pairs above and below.
-    for p in rosette(Point::new(707.0, 707.0), 1.45) {
+    // Centre rosette with the filigree above and (turned) below.
+    for p in rosette(Point::new(707.0, 707.0), 1.02) {
         art.add("#000", p);
     }
-    let half = scroll_half();
-    for (flip_y, y) in [(1.0, 320.0), (-1.0, 1094.0)] {
-        for flip_x in [1.0, -1.0] {
-            let a = Affine::translate((707.0, y)) * Affine::scale_non_uniform(flip_x * 1.1, -flip_y * 1.1);
-            for p in &half {
-                art.add("#000", place(p, a));
-            }
-        }
+    let comp = scroll_composition();
+    let top = Affine::translate((707.0 - 0.8 * 384.0, 190.0)) * Affine::scale(0.8);
+    let bottom = Affine::rotate_about(PI, Point::new(707.0, 707.0)) * top;
+    for p in &comp {
+        art.add("#000", place(p, top));
+        art.add("#000", place(p, bottom));
     }
     art
 }
