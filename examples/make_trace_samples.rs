@@ -579,15 +579,15 @@ fn glyph_g() -> BezPath {
     g.extend(stroke(&ear, &ear_w, Cap::Round, Cap::Butt));
     // Link from the upper bowl down-left, then along the top of the loop.
     let link = Spine::from_path(&bez(&[
-        (238.0, 286.0),
-        (210.0, 296.0),
-        (194.0, 316.0),
-        (208.0, 332.0),
-        (220.0, 344.0),
-        (246.0, 346.0),
+        (240.0, 284.0),
+        (204.0, 292.0),
+        (184.0, 318.0),
+        (206.0, 334.0),
+        (222.0, 345.0),
+        (248.0, 346.0),
         (272.0, 346.0),
     ]));
-    let link_w = |s: f64, t: Vec2| 0.72 * pen(s, t);
+    let link_w = |_s: f64, t: Vec2| pen_w(THIN, 24.0, TILT, t);
     g.extend(stroke(&link, &link_w, Cap::Round, Cap::Round));
     // Lower loop.
     g.extend(ring(&ellipse_spine((262.0, 412.0), 94.0, 66.0), &pen));
@@ -1128,11 +1128,11 @@ fn ornament_2mp() -> Art {
         }
     }
     // Centre rosette with the filigree above and (turned) below.
-    for p in rosette(Point::new(707.0, 707.0), 1.02) {
+    for p in rosette(Point::new(707.0, 707.0), 0.98) {
         art.add("#000", p);
     }
     let comp = scroll_composition();
-    let top = Affine::translate((707.0 - 0.8 * 384.0, 190.0)) * Affine::scale(0.8);
+    let top = Affine::translate((707.0 - 0.8 * 384.0, 150.0)) * Affine::scale(0.8);
     let bottom = Affine::rotate_about(PI, Point::new(707.0, 707.0)) * top;
     for p in &comp {
         art.add("#000", place(p, top));
