@@ -636,7 +636,10 @@ fn glyph_s() -> BezPath {
     bar.curve_to((324.0, 206.0), (327.0, 194.0), (327.0, 164.0));
     bar.close_path();
     let bar = orient(bar, true);
-    g.extend(place(&bar, Affine::rotate_about(PI, Point::new(257.0, 280.0))));
+    g.extend(place(
+        &bar,
+        Affine::rotate_about(PI, Point::new(257.0, 280.0)),
+    ));
     g.extend(bar);
     g
 }
@@ -677,10 +680,22 @@ fn scroll_half() -> Vec<BezPath> {
     let main_dir = Vec2::new(1.0, 0.22);
     let main_w = swell(0.0, 15.0, 3.0, 0.3);
     out.push(scroll(
-        main_start, main_dir, 70.0, 80.0, big, &main_w, Cap::Round, 6.0,
+        main_start,
+        main_dir,
+        70.0,
+        80.0,
+        big,
+        &main_w,
+        Cap::Round,
+        6.0,
     ));
     let (q, tq) = big.start();
-    let lead = CubicBez::new(main_start, main_start + unit(main_dir) * 70.0, q - tq * 80.0, q);
+    let lead = CubicBez::new(
+        main_start,
+        main_start + unit(main_dir) * 70.0,
+        q - tq * 80.0,
+        q,
+    );
     let on_main = |u: f64| (lead.eval(u), unit(lead.deriv().eval(u).to_vec2()));
     // Secondary scroll branching off below, curling down.
     let (bq, btan) = on_main(0.42);
@@ -693,7 +708,16 @@ fn scroll_half() -> Vec<BezPath> {
         ratio: 0.24,
     };
     let small_w = swell(2.0, 10.0, 2.4, 0.32);
-    out.push(scroll(bq, btan, 30.0, 40.0, small, &small_w, Cap::Round, 4.6));
+    out.push(scroll(
+        bq,
+        btan,
+        30.0,
+        40.0,
+        small,
+        &small_w,
+        Cap::Round,
+        4.6,
+    ));
     // Upper tendril: from the main stroke up and curling left.
     let (tq0, ttan) = on_main(0.3);
     let tendril = Volute {
@@ -751,7 +775,13 @@ fn scroll_composition() -> Vec<BezPath> {
     out.push(side);
     out.push(dot(Point::new(384.0, 132.0), 7.0));
     out.push(dot(Point::new(384.0, 114.0), 4.0));
-    out.push(leaf(c + Vec2::new(0.0, 4.0), Point::new(384.0, 392.0), 0.0, 20.0, 0.0));
+    out.push(leaf(
+        c + Vec2::new(0.0, 4.0),
+        Point::new(384.0, 392.0),
+        0.0,
+        20.0,
+        0.0,
+    ));
     out.push(dot(Point::new(384.0, 406.0), 4.5));
     out
 }
@@ -797,10 +827,14 @@ fn rosette(c: Point, k: f64) -> Vec<BezPath> {
             polar(c, 180.0 * k, a),
             polar(c, 196.0 * k, a),
         )]);
-        let hw = move |s: f64, _t: Vec2| 0.5 * 30.0 * k * (s * (2.0 - s)).powf(1.1).min(1.0) * 0.5
-            + 0.5 * 30.0 * k * 0.5 * s;
+        let hw = move |s: f64, _t: Vec2| {
+            0.5 * 30.0 * k * (s * (2.0 - s)).powf(1.1).min(1.0) * 0.5 + 0.5 * 30.0 * k * 0.5 * s
+        };
         let mut lobe = stroke(&sp, &hw, Cap::Round, Cap::Round);
-        lobe.extend(orient(Circle::new(polar(c, 182.0 * k, a), 5.0 * k).to_path(1e-3), false));
+        lobe.extend(orient(
+            Circle::new(polar(c, 182.0 * k, a), 5.0 * k).to_path(1e-3),
+            false,
+        ));
         out.push(lobe);
         let b = a + TAU / 32.0;
         out.push(dot(polar(c, 148.0 * k, b), 3.5 * k));
@@ -870,7 +904,10 @@ fn thin_lines() -> Art {
         // Horizontal and vertical on the pixel grid, plus a diagonal.
         art.add(
             "#000",
-            orient(Rect::new(20.0, y - w / 2.0, 140.0, y + w / 2.0).to_path(0.1), true),
+            orient(
+                Rect::new(20.0, y - w / 2.0, 140.0, y + w / 2.0).to_path(0.1),
+                true,
+            ),
         );
         art.add(
             "#000",
@@ -881,7 +918,10 @@ fn thin_lines() -> Art {
         );
         art.add(
             "#000",
-            polyline(&[Point::new(164.0, y + 38.0), Point::new(230.0, y - 38.0)], *w),
+            polyline(
+                &[Point::new(164.0, y + 38.0), Point::new(230.0, y - 38.0)],
+                *w,
+            ),
         );
         // A mitred zig-zag with sharp corners.
         art.add(
@@ -1046,7 +1086,7 @@ fn vine(n: usize, period: f64, amp: f64) -> Vec<BezPath> {
         )
     });
     let hw = swell(0.0, 6.0, 0.0, 0.5);
-    let hw = move |s: f64, t: Vec2| hw(s, t).max(0.0).min(3.0) * (s * 40.0).min(1.0);
+    let hw = move |s: f64, t: Vec2| hw(s, t).clamp(0.0, 3.0) * (s * 40.0).min(1.0);
     out.push(stroke(
         &Spine::new(vec![spine]),
         &hw,
@@ -1122,7 +1162,12 @@ fn ornament_2mp() -> Art {
             art.add("#000", place(p, a));
         }
     }
-    for (x, y) in [(127.0, 127.0), (1287.0, 127.0), (127.0, 1287.0), (1287.0, 1287.0)] {
+    for (x, y) in [
+        (127.0, 127.0),
+        (1287.0, 127.0),
+        (127.0, 1287.0),
+        (1287.0, 1287.0),
+    ] {
         for p in rosette(Point::new(x, y), 0.26) {
             art.add("#000", p);
         }
@@ -1241,7 +1286,12 @@ fn main() {
     emit(&dir, "glyph-a", &glyph_art(glyph_a()), Out::GrayAndBinary);
     emit(&dir, "glyph-g", &glyph_art(glyph_g()), Out::Gray);
     emit(&dir, "glyph-s", &glyph_art(glyph_s()), Out::Gray);
-    emit(&dir, "ornament-scroll", &ornament_scroll(), Out::GrayAndBinary);
+    emit(
+        &dir,
+        "ornament-scroll",
+        &ornament_scroll(),
+        Out::GrayAndBinary,
+    );
     emit(&dir, "ornament-rosette", &ornament_rosette(), Out::Gray);
     emit(&dir, "thin-lines", &thin_lines(), Out::GrayAndBinary);
     emit(&dir, "holes", &holes(), Out::Gray);
