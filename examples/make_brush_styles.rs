@@ -50,7 +50,7 @@ const SIZE: f64 = 512.0;
 /// Largest extent of an exemplar's ink; the rest is margin.
 const MAX_EXTENT: f64 = 492.0;
 /// Outline fitting tolerance, in px.
-const FIT_ACCURACY: f64 = 0.05;
+const FIT_ACCURACY: f64 = 0.08;
 
 // ---------------------------------------------------------------------------
 // Randomness and small maths helpers
@@ -198,6 +198,17 @@ impl Centerline {
         ((s / self.h).round().max(0.0) as usize).min(self.n() - 1)
     }
 
+    /// Point and unit tangent at arc length `s`, interpolated between
+    /// samples (for offsetting other curves smoothly along this one).
+    fn frame_at(&self, s: f64) -> (Point, Vec2) {
+        let x = (s / self.h).clamp(0.0, (self.n() - 1) as f64);
+        let i = (x.floor() as usize).min(self.n() - 2);
+        let f = x - i as f64;
+        let p = self.pts[i].lerp(self.pts[i + 1], f);
+        let t = self.tangent(i).lerp(self.tangent(i + 1), f).normalize();
+        (p, t)
+    }
+
     fn point_at(&self, s: f64) -> Point {
         self.pts[self.index_at(s)]
     }
@@ -327,8 +338,10 @@ fn smooth_polyline(raw: &[Point], closed: bool) -> BezPath {
     if closed {
         path.close_path();
     }
+    // (SimplifyOptLevel::Optimize gives ~20% fewer segments but can panic
+    // inside kurbo 0.13 on looping outlines, so plain subdivision it is.)
     let opts = SimplifyOptions::default()
-        .opt_level(SimplifyOptLevel::Optimize)
+        .opt_level(SimplifyOptLevel::Subdivide)
         .angle_thresh(1e-2);
     simplify_bezpath(path, FIT_ACCURACY, &opts)
 }
@@ -1130,22 +1143,580 @@ mod vine {
 
 mod scroll {
     use super::*;
+
+    const INK: usize = 0;
+    /// Direction of the broad nib's edge (up-right, y-down radians): strokes
+    /// moving this way are hairlines, strokes across it are full width.
+    const NIB: f64 = -0.62;
+    /// Hairline half width, px.
+    const THIN: f64 = 1.3;
+
+    /// Half width of a broad-nib stroke moving along `t`.
+    fn nib(t: Vec2, thick: f64) -> f64 {
+        lerp(THIN, thick, (t.atan2() - NIB).sin().abs())
+    }
+
+    #[derive(Clone, Copy)]
+    pub enum Tip {
+        /// A hairline entry or exit.
+        Point,
+        /// A volute curling to the given side (+1 clockwise on screen),
+        /// ending in a ball; `len` is its length in px.
+        Volute { side: f64, len: f64 },
+    }
+
+    /// Feather strokes branching off one side of the main stroke.
+    pub struct Wing {
+        /// +1: left of the drawing direction (up for a left-to-right stroke).
+        pub side: f64,
+        /// Range of the main stroke they grow from, as fractions.
+        pub from: f64,
+        pub to: f64,
+        pub count: usize,
+        /// Feather lengths at the first and the last feather.
+        pub len0: f64,
+        pub len1: f64,
+    }
+
+    /// A secondary scroll: leaves the main stroke and rolls into a volute.
+    pub struct Branch {
+        pub at: f64,
+        pub side: f64,
+        pub len: f64,
+    }
+
+    pub struct Spec {
+        pub seed: u64,
+        pub spine: &'static [(f64, f64)],
+        pub thick: f64,
+        pub start: Tip,
+        pub end: Tip,
+        pub wing: Option<Wing>,
+        pub branches: &'static [Branch],
+    }
+
     pub fn style() -> Style {
+        use Tip::*;
+        let specs = [
+            Spec {
+                seed: 11,
+                spine: &[(0.0, 40.0), (120.0, -40.0), (260.0, -40.0), (360.0, 20.0)],
+                thick: 9.0,
+                start: Point,
+                end: Volute { side: 1.0, len: 200.0 },
+                wing: Some(Wing {
+                    side: 1.0,
+                    from: 0.22,
+                    to: 0.7,
+                    count: 6,
+                    len0: 150.0,
+                    len1: 80.0,
+                }),
+                branches: &[],
+            },
+            Spec {
+                seed: 12,
+                spine: &[(0.0, 0.0), (70.0, -50.0), (140.0, 50.0), (210.0, 0.0)],
+                thick: 8.0,
+                start: Volute { side: 1.0, len: 170.0 },
+                end: Volute { side: 1.0, len: 170.0 },
+                wing: None,
+                branches: &[],
+            },
+            Spec {
+                seed: 13,
+                spine: &[(0.0, 0.0), (110.0, 8.0), (230.0, 8.0), (340.0, -6.0)],
+                thick: 8.5,
+                start: Volute { side: -1.0, len: 190.0 },
+                end: Point,
+                wing: Some(Wing {
+                    side: -1.0,
+                    from: 0.3,
+                    to: 0.75,
+                    count: 4,
+                    len0: 90.0,
+                    len1: 55.0,
+                }),
+                branches: &[],
+            },
+            Spec {
+                seed: 14,
+                spine: &[(0.0, 60.0), (160.0, 70.0), (300.0, 40.0), (360.0, -100.0)],
+                thick: 10.0,
+                start: Point,
+                end: Volute { side: -1.0, len: 190.0 },
+                wing: Some(Wing {
+                    side: -1.0,
+                    from: 0.25,
+                    to: 0.8,
+                    count: 6,
+                    len0: 70.0,
+                    len1: 130.0,
+                }),
+                branches: &[],
+            },
+            Spec {
+                seed: 15,
+                spine: &[(0.0, 0.0), (120.0, -70.0), (200.0, 70.0), (330.0, 0.0)],
+                thick: 9.5,
+                start: Volute { side: 1.0, len: 190.0 },
+                end: Volute { side: 1.0, len: 190.0 },
+                wing: None,
+                branches: &[Branch {
+                    at: 0.5,
+                    side: -1.0,
+                    len: 150.0,
+                }],
+            },
+            Spec {
+                seed: 16,
+                spine: &[(0.0, 20.0), (70.0, -20.0), (150.0, -20.0), (220.0, 20.0)],
+                thick: 7.5,
+                start: Point,
+                end: Volute { side: 1.0, len: 160.0 },
+                wing: Some(Wing {
+                    side: 1.0,
+                    from: 0.25,
+                    to: 0.6,
+                    count: 3,
+                    len0: 85.0,
+                    len1: 60.0,
+                }),
+                branches: &[],
+            },
+            Spec {
+                seed: 17,
+                spine: &[(0.0, 0.0), (140.0, -40.0), (260.0, 40.0), (400.0, 0.0)],
+                thick: 9.0,
+                start: Point,
+                end: Point,
+                wing: None,
+                branches: &[
+                    Branch {
+                        at: 0.3,
+                        side: 1.0,
+                        len: 140.0,
+                    },
+                    Branch {
+                        at: 0.65,
+                        side: -1.0,
+                        len: 150.0,
+                    },
+                ],
+            },
+            Spec {
+                seed: 18,
+                spine: &[(0.0, 0.0), (100.0, -4.0), (200.0, 4.0), (300.0, 0.0)],
+                thick: 8.0,
+                start: Volute { side: 1.0, len: 180.0 },
+                end: Volute { side: -1.0, len: 180.0 },
+                wing: None,
+                branches: &[],
+            },
+            Spec {
+                seed: 19,
+                spine: &[(0.0, -60.0), (60.0, 60.0), (200.0, 70.0), (300.0, 20.0)],
+                thick: 10.0,
+                start: Point,
+                end: Volute { side: -1.0, len: 170.0 },
+                wing: Some(Wing {
+                    side: -1.0,
+                    from: 0.35,
+                    to: 0.8,
+                    count: 5,
+                    len0: 110.0,
+                    len1: 70.0,
+                }),
+                branches: &[],
+            },
+            Spec {
+                seed: 20,
+                spine: &[(0.0, 0.0), (130.0, -45.0), (260.0, -45.0), (390.0, 0.0)],
+                thick: 9.0,
+                start: Volute { side: -1.0, len: 180.0 },
+                end: Point,
+                wing: Some(Wing {
+                    side: -1.0,
+                    from: 0.3,
+                    to: 0.85,
+                    count: 5,
+                    len0: 60.0,
+                    len1: 110.0,
+                }),
+                branches: &[Branch {
+                    at: 0.2,
+                    side: 1.0,
+                    len: 120.0,
+                }],
+            },
+        ];
         Style {
             name: "scroll",
             colors: &["#000"],
-            exemplars: vec![],
+            exemplars: specs.iter().map(build).collect(),
         }
+    }
+
+    /// A volute continuing a stroke from `p` along `angle`.
+    fn volute(p: Point, angle: f64, side: f64, len: f64) -> Centerline {
+        spiral(p, angle, len * 1.3, side * 0.003, side * 0.08, 2.1)
+    }
+
+    /// Radius of a volute's ball terminal.
+    fn ball_radius(thick: f64) -> f64 {
+        0.42 * thick + 2.5
+    }
+
+    pub fn build(spec: &Spec) -> Exemplar {
+        let mut rng = Lcg::new(spec.seed);
+        let main = Centerline::from_path(&spine_path(spec.spine));
+        let l = main.len();
+        let thick = spec.thick * 1.2;
+        let mut full = main.clone();
+        let (mut pre, mut post) = (0.0, 0.0);
+        let mut balls = Vec::new();
+        if let Tip::Volute { side, len } = spec.start {
+            let v = volute(main.start(), main.start_angle() + PI, side, len);
+            balls.push(v.end());
+            pre = v.len();
+            full = v.reversed().concat(&full);
+        }
+        if let Tip::Volute { side, len } = spec.end {
+            let v = volute(main.end(), main.end_angle(), side, len);
+            balls.push(v.end());
+            post = v.len();
+            full = full.concat(&v);
+        }
+        let total = full.len();
+        // Envelope: hairline entries/exits taper over the outer 30%;
+        // volutes thin toward their ball.
+        let envelope = |s: f64| -> f64 {
+            if s < pre {
+                lerp(0.45, 1.0, (s / pre).powf(0.8))
+            } else if s > pre + l {
+                lerp(0.45, 1.0, ((total - s) / post).powf(0.8))
+            } else {
+                let m = s - pre;
+                let a = if pre > 0.0 { 1.0 } else { smoothstep(0.0, 0.3 * l, m) };
+                let b = if post > 0.0 { 1.0 } else { smoothstep(0.0, 0.3 * l, l - m) };
+                a.min(b)
+            }
+        };
+        let width = |u: f64, t: Vec2| -> f64 {
+            let e = envelope(u * total);
+            // The hairline part fades in over the first few px only.
+            let hair = smoothstep(0.0, 0.02, u.min(1.0 - u)).sqrt();
+            THIN * hair + (nib(t, thick) - THIN) * e
+        };
+        // The spine: where the main stroke is at least 2.5 px wide (half).
+        let ok = |s: f64| width((s + pre) / total, main.tangent_at(s)) >= 2.5;
+        let mut s0 = 0.0;
+        while !ok(s0) && s0 < 0.3 * l {
+            s0 += 1.0;
+        }
+        let mut s1 = l;
+        while !ok(s1) && s1 > 0.7 * l {
+            s1 -= 1.0;
+        }
+        let mut ex = Exemplar::new(main.slice(s0 + 2.0, s1 - 2.0));
+        ex.add(INK, stroke(&full, width));
+        for b in balls {
+            ex.add(INK, circle(b, ball_radius(thick)));
+        }
+        if let Some(w) = &spec.wing {
+            add_wing(&mut ex, &mut rng, &main, w, thick);
+        }
+        for b in spec.branches {
+            add_branch(&mut ex, &main, b, thick);
+        }
+        ex.fit_to_canvas(&format!("scroll seed {}", spec.seed));
+        ex
+    }
+
+    /// Comma-shaped feathers: they swell just off the main stroke and
+    /// taper to a point that hooks slightly forward.
+    fn add_wing(ex: &mut Exemplar, rng: &mut Lcg, main: &Centerline, w: &Wing, thick: f64) {
+        let l = main.len();
+        for i in 0..w.count {
+            let f = if w.count > 1 {
+                i as f64 / (w.count - 1) as f64
+            } else {
+                0.5
+            };
+            let s = lerp(w.from, w.to, f) * l;
+            let len = lerp(w.len0, w.len1, f) * rng.range(0.95, 1.05);
+            // Out of the main stroke, leaning toward its end.
+            let lean = lerp(1.0, 0.8, f) + rng.range(-0.04, 0.04);
+            let a = main.angle_at(s) - w.side * lean;
+            // Turn back toward the drawing direction, hooking at the tip.
+            let curl = w.side;
+            let line = Centerline::turtle(main.point_at(s), a, len, |u| {
+                curl * (-0.004 + 0.016 * u.powf(1.5) + 0.015 * smoothstep(0.7, 1.0, u))
+            });
+            let fw = 0.75 * thick;
+            ex.add(
+                INK,
+                stroke(&line, |u, t| {
+                    let swell = lerp(0.55, 1.0, smoothstep(0.0, 0.15, u));
+                    let taper = ((1.0 - u) / 0.85).min(1.0).powf(1.3);
+                    nib(t, fw) * swell * taper
+                }),
+            );
+        }
+    }
+
+    /// A smaller scroll leaving the main stroke and rolling into a volute.
+    fn add_branch(ex: &mut Exemplar, main: &Centerline, b: &Branch, thick: f64) {
+        let s = b.at * main.len();
+        let a = main.angle_at(s) - b.side * 0.45;
+        // Leave gently, then roll up against the direction of the main stroke.
+        let k1 = b.side * 0.12;
+        let line = Centerline::turtle(main.point_at(s), a, b.len, |u| {
+            -b.side * 0.012 * (1.0 - u) + k1 * u.powf(1.8)
+        });
+        let bt = 0.7 * thick;
+        ex.add(
+            INK,
+            stroke(&line, |u, t| {
+                let e = lerp(1.0, 0.45, u.powf(0.8)) * smoothstep(0.0, 0.12, u).sqrt();
+                THIN + (nib(t, bt) - THIN) * e
+            }),
+        );
+        ex.add(INK, circle(line.end(), ball_radius(bt)));
     }
 }
 
 mod doodle {
     use super::*;
+
+    const INK: usize = 0;
+
+    #[derive(Clone, Copy)]
+    pub enum Cap {
+        /// A round blob of ink.
+        Ball,
+        /// A small curl turning to the given side, tapering to a point.
+        Hook(f64),
+    }
+
+    pub struct Spec {
+        pub seed: u64,
+        pub spine: &'static [(f64, f64)],
+        pub loops: usize,
+        /// Loop height (centred cords swing ±height), px.
+        pub height: f64,
+        /// Backward reach per loop relative to the forward advance (> 1
+        /// makes loops; larger is tighter, more overlapping loops).
+        pub reach: f64,
+        /// Loops on one side of the spine (cursive e-loops) instead of
+        /// centred on it (telephone cord).
+        pub garland: bool,
+        /// Pen half width, px.
+        pub pen: f64,
+        pub start: Cap,
+        pub end: Cap,
+    }
+
     pub fn style() -> Style {
+        use Cap::*;
+        let specs = [
+            Spec {
+                seed: 21,
+                spine: &[(0.0, 0.0), (130.0, -6.0), (270.0, 6.0), (400.0, 0.0)],
+                loops: 7,
+                height: 38.0,
+                reach: 2.2,
+                garland: false,
+                pen: 3.2,
+                start: Ball,
+                end: Ball,
+            },
+            Spec {
+                seed: 22,
+                spine: &[(0.0, 0.0), (70.0, 0.0), (130.0, 0.0), (200.0, 0.0)],
+                loops: 4,
+                height: 46.0,
+                reach: 1.8,
+                garland: true,
+                pen: 3.0,
+                start: Ball,
+                end: Hook(1.0),
+            },
+            Spec {
+                seed: 23,
+                spine: &[(0.0, 40.0), (120.0, -50.0), (260.0, -50.0), (380.0, 40.0)],
+                loops: 6,
+                height: 52.0,
+                reach: 1.6,
+                garland: true,
+                pen: 3.4,
+                start: Hook(-1.0),
+                end: Ball,
+            },
+            Spec {
+                seed: 24,
+                spine: &[(0.0, 0.0), (150.0, -80.0), (290.0, 80.0), (440.0, 0.0)],
+                loops: 10,
+                height: 28.0,
+                reach: 2.8,
+                garland: false,
+                pen: 3.0,
+                start: Ball,
+                end: Ball,
+            },
+            Spec {
+                seed: 25,
+                spine: &[(0.0, 0.0), (180.0, 0.0), (260.0, -20.0), (300.0, -160.0)],
+                loops: 6,
+                height: 38.0,
+                reach: 2.0,
+                garland: false,
+                pen: 3.4,
+                start: Hook(1.0),
+                end: Hook(-1.0),
+            },
+            Spec {
+                seed: 26,
+                spine: &[(0.0, 0.0), (100.0, 10.0), (200.0, 10.0), (300.0, 0.0)],
+                loops: 4,
+                height: 72.0,
+                reach: 2.2,
+                garland: true,
+                pen: 3.6,
+                start: Ball,
+                end: Hook(1.0),
+            },
+            Spec {
+                seed: 27,
+                spine: &[(0.0, 0.0), (160.0, 0.0), (310.0, 0.0), (470.0, 0.0)],
+                loops: 12,
+                height: 24.0,
+                reach: 3.2,
+                garland: false,
+                pen: 2.9,
+                start: Ball,
+                end: Ball,
+            },
+            Spec {
+                seed: 28,
+                spine: &[(0.0, -30.0), (80.0, 40.0), (180.0, 40.0), (260.0, -30.0)],
+                loops: 4,
+                height: 48.0,
+                reach: 1.7,
+                garland: false,
+                pen: 3.3,
+                start: Hook(-1.0),
+                end: Ball,
+            },
+            Spec {
+                seed: 29,
+                spine: &[(0.0, 0.0), (130.0, 50.0), (270.0, -50.0), (400.0, 0.0)],
+                loops: 6,
+                height: 50.0,
+                reach: 2.0,
+                garland: true,
+                pen: 3.2,
+                start: Ball,
+                end: Ball,
+            },
+            Spec {
+                seed: 30,
+                spine: &[(0.0, 60.0), (120.0, 70.0), (260.0, 40.0), (330.0, -60.0)],
+                loops: 5,
+                height: 54.0,
+                reach: 2.4,
+                garland: false,
+                pen: 3.4,
+                start: Ball,
+                end: Hook(1.0),
+            },
+        ];
         Style {
             name: "doodle",
             colors: &["#1b2a4a"],
-            exemplars: vec![],
+            exemplars: specs.iter().map(build).collect(),
         }
+    }
+
+    /// The pen's path: a trochoid (prolate cycloid) laid along the spine,
+    /// with loops easing in and out at the ends so the line starts and ends
+    /// on the spine.
+    fn pen_path(spec: &Spec, base: &Centerline, rng: &mut Lcg) -> Centerline {
+        let l = base.len();
+        let n = spec.loops as f64;
+        let t_end = TAU * n;
+        let a = l / t_end;
+        let b = spec.reach * a;
+        // Per-loop size jitter, smoothly interpolated: hand-drawn unevenness.
+        let amps: Vec<f64> = (0..=spec.loops + 1).map(|_| rng.range(0.85, 1.12)).collect();
+        let amp = |t: f64| {
+            let x = t / TAU;
+            let i = (x.floor() as usize).min(spec.loops);
+            let f = 0.5 - 0.5 * (PI * x.fract()).cos();
+            lerp(amps[i], amps[i + 1], f)
+        };
+        let ease = 0.75 * TAU;
+        let samples = (t_end / 0.004) as usize;
+        let mut dense = Vec::with_capacity(samples + 1);
+        for i in 0..=samples {
+            let t = t_end * i as f64 / samples as f64;
+            let e = smoothstep(0.0, ease, t) * smoothstep(0.0, ease, t_end - t) * amp(t);
+            let x = (a * t + e * b * t.sin()).clamp(0.0, l);
+            // Loops form where the pen runs backward, at t = π (mod 2π).
+            let y = if spec.garland {
+                e * spec.height * 0.5 * (1.0 - t.cos())
+            } else {
+                -e * spec.height * 0.5 * t.cos()
+            };
+            let (p, tangent) = base.frame_at(x);
+            dense.push(p + left_of(tangent) * y);
+        }
+        Centerline::from_points(&dense)
+    }
+
+    /// A small hook continuing the line from `p` along `angle`.
+    fn hook(p: Point, angle: f64, side: f64) -> Centerline {
+        spiral(p, angle, 46.0, side * 0.02, side * 0.16, 1.4)
+    }
+
+    pub fn build(spec: &Spec) -> Exemplar {
+        let mut rng = Lcg::new(spec.seed);
+        let base = Centerline::from_path(&spine_path(spec.spine));
+        let mut line = pen_path(spec, &base, &mut rng);
+        let mut ex = Exemplar::new(base.slice(0.5, base.len() - 0.5));
+        let (mut pre, mut post) = (0.0, 0.0);
+        if let Cap::Hook(side) = spec.start {
+            let h = hook(line.start(), line.start_angle() + PI, side);
+            pre = h.len();
+            line = h.reversed().concat(&line);
+        }
+        if let Cap::Hook(side) = spec.end {
+            let h = hook(line.end(), line.end_angle(), side);
+            post = h.len();
+            line = line.concat(&h);
+        }
+        let total = line.len();
+        let pen = spec.pen;
+        let phase = rng.range(0.0, TAU);
+        let width = |u: f64, _t: Vec2| -> f64 {
+            let s = u * total;
+            // A little pen pressure variation; hooks flick off to a point.
+            let w = pen * (1.0 + 0.1 * (s / 37.0 + phase).sin());
+            let a = if pre > 0.0 { (s / pre).min(1.0).powf(0.6) } else { 1.0 };
+            let b = if post > 0.0 {
+                ((total - s) / post).min(1.0).powf(0.6)
+            } else {
+                1.0
+            };
+            w * a.min(b)
+        };
+        ex.add(INK, stroke(&line, width));
+        for (cap, p) in [(spec.start, base.start()), (spec.end, base.end())] {
+            if let Cap::Ball = cap {
+                ex.add(INK, circle(p, 2.0 * pen));
+            }
+        }
+        ex.fit_to_canvas(&format!("doodle seed {}", spec.seed));
+        ex
     }
 }
