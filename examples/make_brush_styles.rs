@@ -31,11 +31,15 @@
 //! cargo run --release --example make_brush_styles -- styles/
 //! ```
 //!
+//! An optional second argument (`vine`, `scroll` or `doodle`) writes just
+//! that style. Set `BRUSH_ART_DEBUG=DIR` to also get a full-size PNG of
+//! every exemplar with its spine drawn in red.
+//!
 //! Besides the exemplars, each style folder gets a `sheet.png` preview
 //! (all exemplars on white, spine in red) for judging the art by eye; it
 //! is not part of the library and is git-ignored.
 
-use std::f64::consts::{FRAC_PI_2, PI, TAU};
+use std::f64::consts::{PI, TAU};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -281,7 +285,7 @@ impl Centerline {
 fn smooth_polyline(raw: &[Point], closed: bool) -> BezPath {
     let mut pts: Vec<Point> = Vec::with_capacity(raw.len());
     for &p in raw {
-        if pts.last().is_none_or(|q: &Point| (p - *q).hypot() > 0.02) {
+        if pts.last().map_or(true, |q: &Point| (p - *q).hypot() > 0.02) {
             pts.push(p);
         }
     }
@@ -468,8 +472,16 @@ fn leaf(base: Point, angle: f64, shape: &LeafShape) -> BezPath {
         let r = 0.11 * w;
         let (x0, x1) = (0.07 * l, 0.84 * l);
         p.move_to(bent(x0, r));
-        p.curve_to(bent(x0 + 0.25 * l, r), bent(x1 - 0.3 * l, 0.25 * r), bent(x1, 0.0));
-        p.curve_to(bent(x1 - 0.3 * l, -0.25 * r), bent(x0 + 0.25 * l, -r), bent(x0, -r));
+        p.curve_to(
+            bent(x0 + 0.25 * l, r),
+            bent(x1 - 0.3 * l, 0.25 * r),
+            bent(x1, 0.0),
+        );
+        p.curve_to(
+            bent(x1 - 0.3 * l, -0.25 * r),
+            bent(x0 + 0.25 * l, -r),
+            bent(x0, -r),
+        );
         p.curve_to(bent(x0 - 0.6 * r, -r), bent(x0 - 0.6 * r, r), bent(x0, r));
         p.close_path();
     }
@@ -656,8 +668,9 @@ fn render(svg: &str, pixmap: &mut tiny_skia::Pixmap, xf: tiny_skia::Transform) {
     resvg::render(&tree, xf, &mut pixmap.as_mut());
 }
 
-/// Checks that the spine lies on the ink (its ends in particular).
-fn check_spine(name: &str, ex: &Exemplar, svg: &str) -> bool {
+/// Checks that the spine's ends lie on the ink, and with `whole` that
+/// all of it does.
+fn check_spine(name: &str, ex: &Exemplar, svg: &str, whole: bool) -> bool {
     let mut pm = tiny_skia::Pixmap::new(512, 512).unwrap();
     render(svg, &mut pm, tiny_skia::Transform::identity());
     let alpha = |p: Point| -> u8 {
@@ -676,7 +689,7 @@ fn check_spine(name: &str, ex: &Exemplar, svg: &str) -> bool {
         }
     }
     let off = sp.pts.iter().filter(|&&p| alpha(p) < 128).count();
-    if off > 0 {
+    if off > 0 && whole {
         eprintln!(
             "  {name}: {off} of {} spine samples off the ink",
             sp.pts.len()
@@ -689,6 +702,9 @@ struct Style {
     name: &'static str,
     colors: &'static [&'static str],
     exemplars: Vec<Exemplar>,
+    /// Whether the whole spine runs on the ink (not so for the doodle,
+    /// whose line loops around its spine).
+    spine_on_ink: bool,
 }
 
 fn write_style(root: &Path, style: Style) -> std::io::Result<()> {
@@ -705,7 +721,7 @@ fn write_style(root: &Path, style: Style) -> std::io::Result<()> {
         let file = format!("{name}.svg");
         let svg = ex.svg(style.colors, false);
         std::fs::write(dir.join(&file), &svg)?;
-        check_spine(&name, ex, &svg);
+        check_spine(&name, ex, &svg, style.spine_on_ink);
         let (s, e) = (ex.spine.start(), ex.spine.end());
         let _ = write!(
             toml,
@@ -714,7 +730,13 @@ fn write_style(root: &Path, style: Style) -> std::io::Result<()> {
         );
         let (cx, cy) = ((i % cols) as u32 * cell, (i / cols) as u32 * cell);
         let k = cell as f32 / 512.0;
-        let frame = tiny_skia::Rect::from_xywh(cx as f32 + 1.0, cy as f32 + 1.0, cell as f32 - 2.0, cell as f32 - 2.0).unwrap();
+        let frame = tiny_skia::Rect::from_xywh(
+            cx as f32 + 1.0,
+            cy as f32 + 1.0,
+            cell as f32 - 2.0,
+            cell as f32 - 2.0,
+        )
+        .unwrap();
         let mut paint = tiny_skia::Paint::default();
         paint.set_color_rgba8(236, 236, 236, 255);
         let path = tiny_skia::PathBuilder::from_rect(frame);
@@ -736,14 +758,19 @@ fn write_style(root: &Path, style: Style) -> std::io::Result<()> {
             render(&svg, &mut pm, id);
             render(&ex.svg(style.colors, true), &mut pm, id);
             let img = image::RgbaImage::from_raw(512, 512, pm.data().to_vec()).unwrap();
-            img.save(Path::new(&dbg).join(format!("{name}.png"))).unwrap();
+            img.save(Path::new(&dbg).join(format!("{name}.png")))
+                .unwrap();
         }
     }
     std::fs::write(dir.join("style.toml"), toml)?;
     let img = image::RgbaImage::from_raw(sheet.width(), sheet.height(), sheet.data().to_vec())
         .expect("sheet buffer");
     img.save(dir.join("sheet.png")).expect("write sheet.png");
-    println!("wrote {} ({} exemplars)", dir.display(), style.exemplars.len());
+    println!(
+        "wrote {} ({} exemplars)",
+        dir.display(),
+        style.exemplars.len()
+    );
     Ok(())
 }
 
@@ -815,7 +842,7 @@ mod vine {
         let specs = [
             Spec {
                 seed: 1,
-                spine: &[(0.0, 0.0), (150.0, -30.0), (300.0, 30.0), (420.0, 0.0)],
+                spine: &[(0.0, 0.0), (130.0, -30.0), (260.0, 30.0), (370.0, 0.0)],
                 width: 7.0,
                 start: Start::Curl,
                 end: End::Leaf,
@@ -839,7 +866,7 @@ mod vine {
             },
             Spec {
                 seed: 3,
-                spine: &[(0.0, 40.0), (120.0, -60.0), (300.0, -60.0), (400.0, 40.0)],
+                spine: &[(0.0, 40.0), (110.0, -60.0), (260.0, -60.0), (350.0, 40.0)],
                 width: 7.7,
                 start: Start::Curl,
                 end: End::Curl,
@@ -899,7 +926,7 @@ mod vine {
             },
             Spec {
                 seed: 8,
-                spine: &[(0.0, 0.0), (140.0, 2.0), (260.0, -2.0), (380.0, 0.0)],
+                spine: &[(0.0, 0.0), (120.0, 2.0), (220.0, -2.0), (330.0, 0.0)],
                 width: 7.7,
                 start: Start::Curl,
                 end: End::Leaf,
@@ -927,10 +954,10 @@ mod vine {
                     (0.0, 0.0),
                     (80.0, -40.0),
                     (150.0, -40.0),
-                    (220.0, 0.0),
-                    (290.0, 40.0),
-                    (360.0, 30.0),
-                    (420.0, -10.0),
+                    (210.0, 0.0),
+                    (270.0, 35.0),
+                    (320.0, 30.0),
+                    (370.0, -10.0),
                 ],
                 width: 8.4,
                 start: Start::Curl,
@@ -946,6 +973,7 @@ mod vine {
             name: "vine",
             colors: &["#2f5d3a", "#6b9a45"],
             exemplars: specs.iter().map(build).collect(),
+            spine_on_ink: true,
         }
     }
 
@@ -979,7 +1007,14 @@ mod vine {
         let end_curl = (spec.end == End::Curl).then(|| {
             let side = spec.first_side;
             let len = curl_len(w1) * 0.9;
-            spiral(main.end(), main.end_angle(), len, side * 0.004, side * 0.13, 2.0)
+            spiral(
+                main.end(),
+                main.end_angle(),
+                len,
+                side * 0.004,
+                side * 0.13,
+                2.0,
+            )
         });
         let pre = start_curl.as_ref().map_or(0.0, |c| c.len());
         let post = end_curl.as_ref().map_or(0.0, |c| c.len());
@@ -1086,21 +1121,30 @@ mod vine {
     }
 
     /// A thin tendril that leaves the stem and rolls up into a spiral.
-    fn add_tendril(ex: &mut Exemplar, rng: &mut Lcg, p: Point, stem_angle: f64, side: f64, size: f64) {
+    fn add_tendril(
+        ex: &mut Exemplar,
+        rng: &mut Lcg,
+        p: Point,
+        stem_angle: f64,
+        side: f64,
+        size: f64,
+    ) {
         let out = stem_angle - side * rng.range(0.55, 0.75);
         let len = rng.range(150.0, 180.0) * size;
         // Curl back toward the stem's start, away from the leaves ahead.
         let line = spiral(p, out, len, side * 0.008, -side * 0.17, 1.9);
-        let line = {
-            // Bend the first part outward before rolling inward.
-            let _ = side;
-            line
-        };
         ex.add(STEM, stroke(&line, |u, _| 3.0 * (1.0 - u).powf(0.7)));
     }
 
     /// Three berries on a forked stalk.
-    fn add_berries(ex: &mut Exemplar, rng: &mut Lcg, p: Point, stem_angle: f64, side: f64, size: f64) {
+    fn add_berries(
+        ex: &mut Exemplar,
+        rng: &mut Lcg,
+        p: Point,
+        stem_angle: f64,
+        side: f64,
+        size: f64,
+    ) {
         let out = stem_angle - side * rng.range(0.7, 0.9);
         let stalk = Centerline::turtle(p, out, 24.0 * size, |_| 0.0);
         ex.add(STEM, stroke(&stalk, |u, _| lerp(2.6, 2.0, u)));
@@ -1133,13 +1177,18 @@ mod vine {
                 widest: 0.35,
                 midrib: false,
             };
-            ex.add(STEM, leaf(p + dir(angle) * 1.0, angle + side * 0.55, &sepal));
+            ex.add(
+                STEM,
+                leaf(p + dir(angle) * 1.0, angle + side * 0.55, &sepal),
+            );
         }
         ex.add(STEM, circle(p, stem_w * 1.15));
-        let _ = FRAC_PI_2;
-        let _ = TAU;
     }
 }
+
+// ---------------------------------------------------------------------------
+// Scroll
+// ---------------------------------------------------------------------------
 
 mod scroll {
     use super::*;
@@ -1203,7 +1252,10 @@ mod scroll {
                 spine: &[(0.0, 40.0), (120.0, -40.0), (260.0, -40.0), (360.0, 20.0)],
                 thick: 9.0,
                 start: Point,
-                end: Volute { side: 1.0, len: 200.0 },
+                end: Volute {
+                    side: 1.0,
+                    len: 200.0,
+                },
                 wing: Some(Wing {
                     side: 1.0,
                     from: 0.22,
@@ -1218,8 +1270,14 @@ mod scroll {
                 seed: 12,
                 spine: &[(0.0, 0.0), (70.0, -50.0), (140.0, 50.0), (210.0, 0.0)],
                 thick: 8.0,
-                start: Volute { side: 1.0, len: 170.0 },
-                end: Volute { side: 1.0, len: 170.0 },
+                start: Volute {
+                    side: 1.0,
+                    len: 170.0,
+                },
+                end: Volute {
+                    side: 1.0,
+                    len: 170.0,
+                },
                 wing: None,
                 branches: &[],
             },
@@ -1227,7 +1285,10 @@ mod scroll {
                 seed: 13,
                 spine: &[(0.0, 0.0), (110.0, 8.0), (230.0, 8.0), (340.0, -6.0)],
                 thick: 8.5,
-                start: Volute { side: -1.0, len: 190.0 },
+                start: Volute {
+                    side: -1.0,
+                    len: 190.0,
+                },
                 end: Point,
                 wing: Some(Wing {
                     side: -1.0,
@@ -1244,7 +1305,10 @@ mod scroll {
                 spine: &[(0.0, 60.0), (160.0, 70.0), (300.0, 40.0), (360.0, -100.0)],
                 thick: 10.0,
                 start: Point,
-                end: Volute { side: -1.0, len: 190.0 },
+                end: Volute {
+                    side: -1.0,
+                    len: 190.0,
+                },
                 wing: Some(Wing {
                     side: -1.0,
                     from: 0.25,
@@ -1257,10 +1321,16 @@ mod scroll {
             },
             Spec {
                 seed: 15,
-                spine: &[(0.0, 0.0), (120.0, -70.0), (200.0, 70.0), (330.0, 0.0)],
+                spine: &[(0.0, 0.0), (100.0, -60.0), (170.0, 60.0), (270.0, 0.0)],
                 thick: 9.5,
-                start: Volute { side: 1.0, len: 190.0 },
-                end: Volute { side: 1.0, len: 190.0 },
+                start: Volute {
+                    side: 1.0,
+                    len: 190.0,
+                },
+                end: Volute {
+                    side: 1.0,
+                    len: 190.0,
+                },
                 wing: None,
                 branches: &[Branch {
                     at: 0.5,
@@ -1273,7 +1343,10 @@ mod scroll {
                 spine: &[(0.0, 20.0), (70.0, -20.0), (150.0, -20.0), (220.0, 20.0)],
                 thick: 7.5,
                 start: Point,
-                end: Volute { side: 1.0, len: 160.0 },
+                end: Volute {
+                    side: 1.0,
+                    len: 160.0,
+                },
                 wing: Some(Wing {
                     side: 1.0,
                     from: 0.25,
@@ -1306,10 +1379,16 @@ mod scroll {
             },
             Spec {
                 seed: 18,
-                spine: &[(0.0, 0.0), (100.0, -4.0), (200.0, 4.0), (300.0, 0.0)],
+                spine: &[(0.0, 0.0), (90.0, -4.0), (180.0, 4.0), (270.0, 0.0)],
                 thick: 8.0,
-                start: Volute { side: 1.0, len: 180.0 },
-                end: Volute { side: -1.0, len: 180.0 },
+                start: Volute {
+                    side: 1.0,
+                    len: 180.0,
+                },
+                end: Volute {
+                    side: -1.0,
+                    len: 180.0,
+                },
                 wing: None,
                 branches: &[],
             },
@@ -1318,7 +1397,10 @@ mod scroll {
                 spine: &[(0.0, -60.0), (60.0, 60.0), (200.0, 70.0), (300.0, 20.0)],
                 thick: 10.0,
                 start: Point,
-                end: Volute { side: -1.0, len: 170.0 },
+                end: Volute {
+                    side: -1.0,
+                    len: 170.0,
+                },
                 wing: Some(Wing {
                     side: -1.0,
                     from: 0.35,
@@ -1333,7 +1415,10 @@ mod scroll {
                 seed: 20,
                 spine: &[(0.0, 0.0), (130.0, -45.0), (260.0, -45.0), (390.0, 0.0)],
                 thick: 9.0,
-                start: Volute { side: -1.0, len: 180.0 },
+                start: Volute {
+                    side: -1.0,
+                    len: 180.0,
+                },
                 end: Point,
                 wing: Some(Wing {
                     side: -1.0,
@@ -1354,6 +1439,7 @@ mod scroll {
             name: "scroll",
             colors: &["#000"],
             exemplars: specs.iter().map(build).collect(),
+            spine_on_ink: true,
         }
     }
 
@@ -1397,8 +1483,16 @@ mod scroll {
                 lerp(0.45, 1.0, ((total - s) / post).powf(0.8))
             } else {
                 let m = s - pre;
-                let a = if pre > 0.0 { 1.0 } else { smoothstep(0.0, 0.3 * l, m) };
-                let b = if post > 0.0 { 1.0 } else { smoothstep(0.0, 0.3 * l, l - m) };
+                let a = if pre > 0.0 {
+                    1.0
+                } else {
+                    smoothstep(0.0, 0.3 * l, m)
+                };
+                let b = if post > 0.0 {
+                    1.0
+                } else {
+                    smoothstep(0.0, 0.3 * l, l - m)
+                };
                 a.min(b)
             }
         };
@@ -1446,19 +1540,17 @@ mod scroll {
             let s = lerp(w.from, w.to, f) * l;
             let len = lerp(w.len0, w.len1, f) * rng.range(0.95, 1.05);
             // Out of the main stroke, leaning toward its end.
-            let lean = lerp(1.0, 0.8, f) + rng.range(-0.04, 0.04);
+            let lean = lerp(1.2, 1.0, f) + rng.range(-0.04, 0.04);
             let a = main.angle_at(s) - w.side * lean;
-            // Turn back toward the drawing direction, hooking at the tip.
-            let curl = w.side;
-            let line = Centerline::turtle(main.point_at(s), a, len, |u| {
-                curl * (-0.004 + 0.016 * u.powf(1.5) + 0.015 * smoothstep(0.7, 1.0, u))
-            });
+            // Sweep toward the drawing direction, ever tighter to the tip.
+            let turn = w.side * 0.85 / len;
+            let line = Centerline::turtle(main.point_at(s), a, len, |u| turn * 2.0 * u);
             let fw = 0.75 * thick;
             ex.add(
                 INK,
                 stroke(&line, |u, t| {
                     let swell = lerp(0.55, 1.0, smoothstep(0.0, 0.15, u));
-                    let taper = ((1.0 - u) / 0.85).min(1.0).powf(1.3);
+                    let taper = ((1.0 - u) / 0.8).min(1.0).powf(1.15);
                     nib(t, fw) * swell * taper
                 }),
             );
@@ -1524,10 +1616,10 @@ mod doodle {
                 seed: 21,
                 spine: &[(0.0, 0.0), (130.0, -6.0), (270.0, 6.0), (400.0, 0.0)],
                 loops: 7,
-                height: 38.0,
+                height: 56.0,
                 reach: 2.2,
                 garland: false,
-                pen: 3.2,
+                pen: 3.6,
                 start: Ball,
                 end: Ball,
             },
@@ -1535,10 +1627,10 @@ mod doodle {
                 seed: 22,
                 spine: &[(0.0, 0.0), (70.0, 0.0), (130.0, 0.0), (200.0, 0.0)],
                 loops: 4,
-                height: 46.0,
-                reach: 1.8,
+                height: 60.0,
+                reach: 2.2,
                 garland: true,
-                pen: 3.0,
+                pen: 3.4,
                 start: Ball,
                 end: Hook(1.0),
             },
@@ -1546,10 +1638,10 @@ mod doodle {
                 seed: 23,
                 spine: &[(0.0, 40.0), (120.0, -50.0), (260.0, -50.0), (380.0, 40.0)],
                 loops: 6,
-                height: 52.0,
-                reach: 1.6,
+                height: 64.0,
+                reach: 2.1,
                 garland: true,
-                pen: 3.4,
+                pen: 3.8,
                 start: Hook(-1.0),
                 end: Ball,
             },
@@ -1557,10 +1649,10 @@ mod doodle {
                 seed: 24,
                 spine: &[(0.0, 0.0), (150.0, -80.0), (290.0, 80.0), (440.0, 0.0)],
                 loops: 10,
-                height: 28.0,
+                height: 42.0,
                 reach: 2.8,
                 garland: false,
-                pen: 3.0,
+                pen: 3.4,
                 start: Ball,
                 end: Ball,
             },
@@ -1568,10 +1660,10 @@ mod doodle {
                 seed: 25,
                 spine: &[(0.0, 0.0), (180.0, 0.0), (260.0, -20.0), (300.0, -160.0)],
                 loops: 6,
-                height: 38.0,
+                height: 52.0,
                 reach: 2.0,
                 garland: false,
-                pen: 3.4,
+                pen: 3.8,
                 start: Hook(1.0),
                 end: Hook(-1.0),
             },
@@ -1579,10 +1671,10 @@ mod doodle {
                 seed: 26,
                 spine: &[(0.0, 0.0), (100.0, 10.0), (200.0, 10.0), (300.0, 0.0)],
                 loops: 4,
-                height: 72.0,
+                height: 80.0,
                 reach: 2.2,
                 garland: true,
-                pen: 3.6,
+                pen: 4.0,
                 start: Ball,
                 end: Hook(1.0),
             },
@@ -1590,10 +1682,10 @@ mod doodle {
                 seed: 27,
                 spine: &[(0.0, 0.0), (160.0, 0.0), (310.0, 0.0), (470.0, 0.0)],
                 loops: 12,
-                height: 24.0,
+                height: 36.0,
                 reach: 3.2,
                 garland: false,
-                pen: 2.9,
+                pen: 3.3,
                 start: Ball,
                 end: Ball,
             },
@@ -1601,10 +1693,10 @@ mod doodle {
                 seed: 28,
                 spine: &[(0.0, -30.0), (80.0, 40.0), (180.0, 40.0), (260.0, -30.0)],
                 loops: 4,
-                height: 48.0,
+                height: 60.0,
                 reach: 1.7,
                 garland: false,
-                pen: 3.3,
+                pen: 3.7,
                 start: Hook(-1.0),
                 end: Ball,
             },
@@ -1612,10 +1704,10 @@ mod doodle {
                 seed: 29,
                 spine: &[(0.0, 0.0), (130.0, 50.0), (270.0, -50.0), (400.0, 0.0)],
                 loops: 6,
-                height: 50.0,
-                reach: 2.0,
+                height: 62.0,
+                reach: 2.3,
                 garland: true,
-                pen: 3.2,
+                pen: 3.6,
                 start: Ball,
                 end: Ball,
             },
@@ -1623,10 +1715,10 @@ mod doodle {
                 seed: 30,
                 spine: &[(0.0, 60.0), (120.0, 70.0), (260.0, 40.0), (330.0, -60.0)],
                 loops: 5,
-                height: 54.0,
+                height: 66.0,
                 reach: 2.4,
                 garland: false,
-                pen: 3.4,
+                pen: 3.8,
                 start: Ball,
                 end: Hook(1.0),
             },
@@ -1635,6 +1727,7 @@ mod doodle {
             name: "doodle",
             colors: &["#1b2a4a"],
             exemplars: specs.iter().map(build).collect(),
+            spine_on_ink: false,
         }
     }
 
@@ -1648,7 +1741,9 @@ mod doodle {
         let a = l / t_end;
         let b = spec.reach * a;
         // Per-loop size jitter, smoothly interpolated: hand-drawn unevenness.
-        let amps: Vec<f64> = (0..=spec.loops + 1).map(|_| rng.range(0.85, 1.12)).collect();
+        let amps: Vec<f64> = (0..=spec.loops + 1)
+            .map(|_| rng.range(0.85, 1.12))
+            .collect();
         let amp = |t: f64| {
             let x = t / TAU;
             let i = (x.floor() as usize).min(spec.loops);
@@ -1660,8 +1755,11 @@ mod doodle {
         let mut dense = Vec::with_capacity(samples + 1);
         for i in 0..=samples {
             let t = t_end * i as f64 / samples as f64;
+            // Loops reach full width sooner than full height, so the first
+            // and last loops are open rather than tiny ink blots.
             let e = smoothstep(0.0, ease, t) * smoothstep(0.0, ease, t_end - t) * amp(t);
-            let x = (a * t + e * b * t.sin()).clamp(0.0, l);
+            let ex = smoothstep(0.0, 0.45 * ease, t) * smoothstep(0.0, 0.45 * ease, t_end - t);
+            let x = (a * t + ex * amp(t) * b * t.sin()).clamp(0.0, l);
             // Loops form where the pen runs backward, at t = π (mod 2π).
             let y = if spec.garland {
                 e * spec.height * 0.5 * (1.0 - t.cos())
@@ -1702,7 +1800,11 @@ mod doodle {
             let s = u * total;
             // A little pen pressure variation; hooks flick off to a point.
             let w = pen * (1.0 + 0.1 * (s / 37.0 + phase).sin());
-            let a = if pre > 0.0 { (s / pre).min(1.0).powf(0.6) } else { 1.0 };
+            let a = if pre > 0.0 {
+                (s / pre).min(1.0).powf(0.6)
+            } else {
+                1.0
+            };
             let b = if post > 0.0 {
                 ((total - s) / post).min(1.0).powf(0.6)
             } else {
