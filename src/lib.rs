@@ -13,7 +13,10 @@
 
 pub mod error;
 pub mod io;
+pub mod pattern;
 pub mod render;
+pub mod sketch;
+pub mod style;
 pub mod svg_out;
 
 pub use error::{Error, Result};
