@@ -199,15 +199,21 @@ pub struct Distribution {
     pub spacing: f64,
     /// The length (1-D) the elements cover: N·spacing.
     pub length: f64,
-    /// The area (2-D) the elements cover, A_ref: the convex hull of the
-    /// centres grown by half a spacing (hull + perimeter·s/2 + π·s²/4).
+    /// Distance between rows when a row example fills a region: the mean
+    /// height of the elements across the row plus half a spacing. Equal to
+    /// `spacing` for a field.
+    pub pitch: f64,
+    /// The area (2-D) the elements cover, A_ref: for a field, the convex
+    /// hull of the centres grown by half a spacing (hull + perimeter·s/2 +
+    /// π·s²/4); for a row, N·spacing·pitch (stacked rows).
     pub area: f64,
 }
 
 impl Distribution {
     /// Analyses centres already expressed in the reference frame (for a
-    /// row, x runs along it).
-    pub fn analyse(centres: Vec<Point>, dim: Dim) -> Distribution {
+    /// row, x runs along it); `heights` are the elements' extents across
+    /// the row (along y).
+    pub fn analyse(centres: Vec<Point>, heights: &[f64], dim: Dim) -> Distribution {
         let n = centres.len();
         let (graph, spacing) = match dim {
             Dim::One => {
@@ -242,13 +248,17 @@ impl Distribution {
             .collect();
         let hull = convex_hull(&centres);
         let (ha, hp) = (polygon_area(&hull).abs(), polygon_perimeter(&hull));
+        let pitch = match dim {
+            Dim::Two => spacing,
+            Dim::One => heights.iter().sum::<f64>() / heights.len().max(1) as f64 + 0.5 * spacing,
+        };
         let area = match dim {
             Dim::Two => ha + hp * spacing / 2.0 + std::f64::consts::PI * spacing * spacing / 4.0,
-            // A row spreads over a band one spacing wide.
-            Dim::One => n as f64 * spacing * spacing,
+            Dim::One => n as f64 * spacing * pitch,
         };
         Distribution {
             dim,
+            pitch,
             length: n as f64 * spacing,
             centres,
             graph,

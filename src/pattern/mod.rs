@@ -169,7 +169,11 @@ impl PatternStyle {
         if dim == Dim::One {
             elements.sort_by(|a, b| a.centre.x.total_cmp(&b.centre.x));
         }
-        let dist = Distribution::analyse(elements.iter().map(|e| e.centre).collect(), dim);
+        let heights: Vec<f64> = elements
+            .iter()
+            .map(|e| 2.0 * (e.axis.y.abs() * e.half_a + e.axis.x.abs() * e.half_b))
+            .collect();
+        let dist = Distribution::analyse(elements.iter().map(|e| e.centre).collect(), &heights, dim);
         let reference = Reference::new(elements, dist, params.rings);
         Ok(PatternStyle {
             example: path.to_path_buf(),
@@ -319,7 +323,7 @@ pub fn synthesize_sketch(opts: &PatternOptions, sk: &Sketch) -> Result<PatternOu
                 QueryKind::Region { outline, fill_rule } => {
                     let region = Region::new(outline, *fill_rule, 0.05)
                         .map_err(|r| Error::invalid(&sk.path, format!("{}: {r}", q.id)))?;
-                    in_region(&style, &region, opts, &key)
+                    in_region(&style, &region, outline, opts, &key)
                 }
             }
             .map_err(|reason| Error::invalid(&sk.path, format!("{}: {reason}", q.id)))?;
@@ -386,9 +390,15 @@ pub fn along_path(
 }
 
 /// 2-D synthesis inside `region`: N_tar = N_ref·A_tar/A_ref Lloyd seeds.
+///
+/// A row example fills a region with rows: Lloyd runs in a space squeezed
+/// across the rows by spacing/pitch, where the CVT is isotropic, and the
+/// seeds are stretched back — an anisotropic CVT with the row's spacing
+/// along x and its pitch along y.
 pub fn in_region(
     style: &PatternStyle,
     region: &Region,
+    outline: &kurbo::BezPath,
     opts: &PatternOptions,
     key: &[u64],
 ) -> std::result::Result<Vec<PlacedElement>, String> {
@@ -396,10 +406,24 @@ pub fn in_region(
     let expected = style.expected_in_area(region.area);
     too_many(expected, opts.max_elements)?;
     let n = (expected.round() as usize).max(1);
-    let lloyd = seeds::lloyd(region, n, rng::hash(key), style.params.lloyd_iterations);
+    let squeeze = r.dist.spacing / r.dist.pitch;
+    let mut points: Vec<Point> = if (squeeze - 1.0).abs() < 1e-9 {
+        seeds::lloyd(region, n, rng::hash(key), style.params.lloyd_iterations).points
+    } else {
+        let squeezed = Region::new(&(Affine::scale_non_uniform(1.0, squeeze) * outline.clone()), region.rule, 0.05)?;
+        seeds::lloyd(&squeezed, n, rng::hash(key), style.params.lloyd_iterations).points
+    };
+    for p in &mut points {
+        p.y /= squeeze;
+    }
+    // Squeezing back can land a seed outside only through the two
+    // flattenings' difference (≤ 0.1 units); such a seed is dropped whole.
+    points.retain(|&p| region.contains(p));
+    let squeezed_pts: Vec<Point> = points.iter().map(|p| Point::new(p.x, p.y * squeeze)).collect();
+    let graph = Graph::delaunay(&squeezed_pts);
     let target = Target {
-        graph: Graph::delaunay(&lloyd.points),
-        pos: lloyd.points,
+        graph,
+        pos: points,
         period: None,
         dim: Dim::Two,
     };
