@@ -61,7 +61,10 @@ fn stipple() -> String {
     let (w, h, r_min) = (180.0, 180.0, 11.0);
     let mut k = 0u64;
     while pts.len() < 400 && k < 20_000 {
-        let p = (8.0 + unit(&[10, k]) * (w - 16.0), 8.0 + unit(&[11, k]) * (h - 16.0));
+        let p = (
+            8.0 + unit(&[10, k]) * (w - 16.0),
+            8.0 + unit(&[11, k]) * (h - 16.0),
+        );
         k += 1;
         if pts.iter().all(|q| (q.0 - p.0).hypot(q.1 - p.1) >= r_min) {
             pts.push(p);
@@ -84,7 +87,10 @@ fn stipple() -> String {
                 r * 1.2
             );
         } else {
-            let _ = writeln!(b, "  <circle cx=\"{x:.2}\" cy=\"{y:.2}\" r=\"{r:.2}\" fill=\"#1f1d1a\"/>");
+            let _ = writeln!(
+                b,
+                "  <circle cx=\"{x:.2}\" cy=\"{y:.2}\" r=\"{r:.2}\" fill=\"#1f1d1a\"/>"
+            );
         }
     }
     svg(w, h, &b)
@@ -99,7 +105,10 @@ fn flowers() -> String {
     for row in 0..rows {
         for col in 0..cols {
             let k = (row * 16 + col) as u64;
-            let cx = 20.0 + col as f64 * dx + if row % 2 == 1 { dx / 2.0 } else { 0.0 } + jitter(&[20, k], 1.2);
+            let cx = 20.0
+                + col as f64 * dx
+                + if row % 2 == 1 { dx / 2.0 } else { 0.0 }
+                + jitter(&[20, k], 1.2);
             let cy = 20.0 + row as f64 * dy + jitter(&[21, k], 1.2);
             let (fill, edge) = colours[col % 2];
             let turn = unit(&[22, k]) * 2.0 * PI / 5.0;
@@ -123,7 +132,10 @@ fn flowers() -> String {
                     by - vy * w + uy * 2.0,
                 );
             }
-            let _ = writeln!(b, "  <circle cx=\"{cx:.2}\" cy=\"{cy:.2}\" r=\"2.2\" fill=\"#f2b632\"/>");
+            let _ = writeln!(
+                b,
+                "  <circle cx=\"{cx:.2}\" cy=\"{cy:.2}\" r=\"2.2\" fill=\"#f2b632\"/>"
+            );
         }
     }
     svg(240.0, 170.0, &b)
@@ -198,7 +210,11 @@ fn main() -> std::io::Result<()> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let styles = root.join("styles");
     let defs: [(&str, String, &str); 4] = [
-        ("hatching", hatching(), "scale = 5.0\nrings = 4\nfit = \"skeleton\"\n"),
+        (
+            "hatching",
+            hatching(),
+            "scale = 5.0\nrings = 4\nfit = \"skeleton\"\n",
+        ),
         ("stipple", stipple(), "scale = 4.0\nrings = 1\n"),
         ("flowers", flowers(), "scale = 7.0\nrings = 2\n"),
         ("brushmarks", brushmarks(), "scale = 2.5\nrings = 5\n"),

@@ -26,7 +26,8 @@ fn main() -> flourish::Result<()> {
     for style in STYLES {
         let dir = root.join("styles").join(style);
         let ps = PatternStyle::load(&dir)?;
-        let ex = std::fs::read_to_string(dir.join("example.svg")).map_err(|e| flourish::Error::io(&dir, e))?;
+        let ex = std::fs::read_to_string(dir.join("example.svg"))
+            .map_err(|e| flourish::Error::io(&dir, e))?;
         write_preview(&ex, &out.join(format!("{style}-example.png")))?;
         println!(
             "{style}: {} strokes -> {} elements, {:?}, spacing {:.2}, A_ref {:.0}",

@@ -177,7 +177,9 @@ struct Preprocessed {
     styles: BTreeMap<String, String>,
 }
 
-const SHAPES: [&str; 7] = ["path", "rect", "circle", "ellipse", "line", "polyline", "polygon"];
+const SHAPES: [&str; 7] = [
+    "path", "rect", "circle", "ellipse", "line", "polyline", "polygon",
+];
 
 /// Reads `viewBox`, `preserveAspectRatio` and `data-style` from the raw XML
 /// and gives styled shapes without an id a private one.
@@ -186,10 +188,11 @@ fn preprocess(path: &Path, text: &str) -> Result<Preprocessed> {
         allow_dtd: true,
         ..Default::default()
     };
-    let doc = usvg::roxmltree::Document::parse_with_options(text, opts).map_err(|e| Error::Svg {
-        path: path.to_path_buf(),
-        reason: e.to_string(),
-    })?;
+    let doc =
+        usvg::roxmltree::Document::parse_with_options(text, opts).map_err(|e| Error::Svg {
+            path: path.to_path_buf(),
+            reason: e.to_string(),
+        })?;
     let root = doc.root_element();
     let view_box = root.attribute("viewBox").and_then(parse_view_box);
     let aspect = root
@@ -255,7 +258,10 @@ fn parse_view_box(s: &str) -> Option<Rect> {
 /// The inverse of the viewBox → viewport mapping of SVG 1.1 §7.8.
 fn viewport_to_user(vb: Rect, width: f64, height: f64, aspect: &str) -> Affine {
     let (sx, sy) = (width / vb.width(), height / vb.height());
-    let words: Vec<&str> = aspect.split_whitespace().filter(|w| *w != "defer").collect();
+    let words: Vec<&str> = aspect
+        .split_whitespace()
+        .filter(|w| *w != "defer")
+        .collect();
     let align = words.first().copied().unwrap_or("xMidYMid");
     let slice = words.get(1) == Some(&"slice");
     let to_viewport = if align == "none" {
@@ -306,8 +312,10 @@ fn add_path(p: &usvg::Path, to_user: Affine, styles: &BTreeMap<String, String>, 
     }
     let abs = to_user * affine_of(p.abs_transform());
     let geom = abs * to_bezpath(p.data(), usvg::Transform::identity());
-    if geom.elements().is_empty() || geom.bounding_box().area() == 0.0 && geom.perimeter(0.1) == 0.0 {
-        sk.notes.push(format!("{label} has no geometry and is ignored"));
+    if geom.elements().is_empty() || geom.bounding_box().area() == 0.0 && geom.perimeter(0.1) == 0.0
+    {
+        sk.notes
+            .push(format!("{label} has no geometry and is ignored"));
         return;
     }
     let n = sk.queries.len() + 1;
@@ -335,8 +343,9 @@ fn add_path(p: &usvg::Path, to_user: Affine, styles: &BTreeMap<String, String>, 
         // transform: by the square root of its determinant.
         let scale = abs.determinant().abs().sqrt();
         let width = stroke.width().get() as f64 * scale;
-        if !(width > 0.0) {
-            sk.notes.push(format!("{label} has a zero stroke width and is ignored"));
+        if width.is_nan() || width <= 0.0 {
+            sk.notes
+                .push(format!("{label} has a zero stroke width and is ignored"));
             return;
         }
         sk.queries.push(Query {
@@ -345,7 +354,9 @@ fn add_path(p: &usvg::Path, to_user: Affine, styles: &BTreeMap<String, String>, 
             kind: QueryKind::Path { spine: geom, width },
         });
     } else {
-        sk.notes.push(format!("{label} has neither fill nor stroke and is ignored"));
+        sk.notes.push(format!(
+            "{label} has neither fill nor stroke and is ignored"
+        ));
     }
 }
 

@@ -24,9 +24,18 @@ pub fn proximity(e1: &Element, e2: &Element) -> f64 {
 /// The continuation error of `other` along the line through `centre` with
 /// direction `axis`, or `None` when `other` is not near-collinear (some
 /// corner farther than ε/2 from the line) (§2.2.2).
-fn continuation_along(own: &[Point; 4], centre: Point, axis: Vec2, other: &[Point; 4], eps: f64) -> Option<f64> {
+fn continuation_along(
+    own: &[Point; 4],
+    centre: Point,
+    axis: Vec2,
+    other: &[Point; 4],
+    eps: f64,
+) -> Option<f64> {
     let normal = Vec2::new(-axis.y, axis.x);
-    if other.iter().any(|&p| (p - centre).dot(normal).abs() >= eps / 2.0) {
+    if other
+        .iter()
+        .any(|&p| (p - centre).dot(normal).abs() >= eps / 2.0)
+    {
         return None;
     }
     let proj = |pts: &[Point; 4]| {
@@ -64,7 +73,9 @@ pub fn groups(e1: &Element, e2: &Element, eps: f64) -> bool {
 /// Clusters the strokes into elements at scale `eps` with the greedy queue
 /// of §2.2, processing strokes in drawing order.
 pub fn cluster(strokes: &[ExampleStroke], eps: f64) -> Vec<Element> {
-    let mut queue: VecDeque<Element> = (0..strokes.len()).map(|i| Element::fit(strokes, vec![i])).collect();
+    let mut queue: VecDeque<Element> = (0..strokes.len())
+        .map(|i| Element::fit(strokes, vec![i]))
+        .collect();
     let mut out = Vec::new();
     while let Some(mut e) = queue.pop_front() {
         let mut merged = false;

@@ -243,7 +243,10 @@ impl Distribution {
         let shift = (0..n)
             .map(|i| {
                 let a = &graph.adj[i];
-                (!a.is_empty()).then(|| a.iter().fold(Vec2::ZERO, |s, &j| s + (centres[i] - centres[j])))
+                (!a.is_empty()).then(|| {
+                    a.iter()
+                        .fold(Vec2::ZERO, |s, &j| s + (centres[i] - centres[j]))
+                })
             })
             .collect();
         let hull = convex_hull(&centres);
@@ -321,7 +324,10 @@ pub fn convex_hull(pts: &[Point]) -> Vec<Point> {
 /// frame, i.e. clockwise on screen).
 pub fn polygon_area(p: &[Point]) -> f64 {
     let n = p.len();
-    (0..n).map(|i| p[i].to_vec2().cross(p[(i + 1) % n].to_vec2())).sum::<f64>() / 2.0
+    (0..n)
+        .map(|i| p[i].to_vec2().cross(p[(i + 1) % n].to_vec2()))
+        .sum::<f64>()
+        / 2.0
 }
 
 /// Perimeter of a closed polygon (for two points: twice their distance).

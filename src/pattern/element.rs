@@ -113,7 +113,10 @@ impl Element {
 
     /// Orientation of A in radians, in [0, π).
     pub fn angle(&self) -> f64 {
-        self.axis.y.atan2(self.axis.x).rem_euclid(std::f64::consts::PI)
+        self.axis
+            .y
+            .atan2(self.axis.x)
+            .rem_euclid(std::f64::consts::PI)
     }
 
     /// The four corners of the box.
@@ -203,13 +206,21 @@ pub fn sample_path(path: &BezPath, h: f64) -> Vec<Point> {
 /// Reads the strokes of an example SVG (any visible path with a fill or a
 /// stroke; colours and widths kept as drawn). `scale` (ε) sets the
 /// sampling step of the fit points.
-pub fn load_example(path: &Path, data: &[u8], fit: FitPoints, scale: f64) -> Result<Vec<ExampleStroke>> {
+pub fn load_example(
+    path: &Path,
+    data: &[u8],
+    fit: FitPoints,
+    scale: f64,
+) -> Result<Vec<ExampleStroke>> {
     let tree = crate::io::parse_svg(path, data)?;
     let h = (scale / 16.0).max(1e-3);
     let mut strokes = Vec::new();
     collect(tree.root(), fit, h, &mut strokes);
     if strokes.is_empty() {
-        return Err(Error::invalid(path, "the pattern example has no visible strokes or filled shapes"));
+        return Err(Error::invalid(
+            path,
+            "the pattern example has no visible strokes or filled shapes",
+        ));
     }
     if strokes.len() > MAX_EXAMPLE_STROKES {
         return Err(Error::invalid(
@@ -278,7 +289,7 @@ fn stroke_of(p: &usvg::Path, fit: FitPoints, h: f64) -> Option<ExampleStroke> {
     });
     let stroke_shape = p.stroke().and_then(|s| {
         let width = s.width().get() as f64 * scale;
-        if !(width > 0.0) {
+        if width.is_nan() || width <= 0.0 {
             return None;
         }
         let c = paint_color(s.paint());
@@ -329,9 +340,15 @@ fn stroke_of(p: &usvg::Path, fit: FitPoints, h: f64) -> Option<ExampleStroke> {
     if points.is_empty() || weight <= 0.0 {
         return None;
     }
-    let color = [color_sum[0] / weight, color_sum[1] / weight, color_sum[2] / weight];
+    let color = [
+        color_sum[0] / weight,
+        color_sum[1] / weight,
+        color_sum[2] / weight,
+    ];
     // Bounding boxes of degenerate geometry are still finite: guard NaN.
-    if !points.iter().all(|p| p.x.is_finite() && p.y.is_finite()) || !geom.bounding_box().is_finite() {
+    if !points.iter().all(|p| p.x.is_finite() && p.y.is_finite())
+        || !geom.bounding_box().is_finite()
+    {
         return None;
     }
     Some(ExampleStroke {

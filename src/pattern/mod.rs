@@ -125,13 +125,18 @@ impl PatternStyle {
         toml.expect_kind(dir, StyleKind::Pattern)?;
         let toml_path = dir.join(style::STYLE_FILE);
         let (Some(scale), Some(ex)) = (toml.scale, toml.exemplar.first()) else {
-            return Err(Error::invalid(toml_path, "a pattern style needs scale and one exemplar"));
+            return Err(Error::invalid(
+                toml_path,
+                "a pattern style needs scale and one exemplar",
+            ));
         };
         let params = PatternParams {
             scale,
             rings: toml.rings.unwrap_or(2) as usize,
             fit: toml.fit.unwrap_or_default(),
-            dimension: toml.dimension.map(|d| if d == 1 { Dim::One } else { Dim::Two }),
+            dimension: toml
+                .dimension
+                .map(|d| if d == 1 { Dim::One } else { Dim::Two }),
             lloyd_iterations: toml.lloyd_iterations.unwrap_or(60) as usize,
         };
         let path = dir.join(&ex.file);
@@ -142,7 +147,10 @@ impl PatternStyle {
     /// Analyses example SVG bytes (§2); `path` names the file in errors.
     pub fn from_example(path: &Path, data: &[u8], params: PatternParams) -> Result<PatternStyle> {
         if !(params.scale.is_finite() && params.scale > 0.0) {
-            return Err(Error::invalid(path, format!("scale must be a positive number, got {}", params.scale)));
+            return Err(Error::invalid(
+                path,
+                format!("scale must be a positive number, got {}", params.scale),
+            ));
         }
         let mut strokes = element::load_example(path, data, params.fit, params.scale)?;
         let clusters = cluster::cluster(&strokes, params.scale);
@@ -152,7 +160,8 @@ impl PatternStyle {
         // so that its principal axis runs along +x (a rotation, never a
         // mirror, so copies stay rigid copies of the example).
         let (c, axis, _, _) = element::fit_box(centres.iter().copied());
-        let mean = centres.iter().fold(Vec2::ZERO, |s, p| s + p.to_vec2()) / centres.len().max(1) as f64;
+        let mean =
+            centres.iter().fold(Vec2::ZERO, |s, p| s + p.to_vec2()) / centres.len().max(1) as f64;
         let _ = c;
         let turn = match dim {
             Dim::One => {
@@ -165,7 +174,10 @@ impl PatternStyle {
         for s in &mut strokes {
             s.transform(frame);
         }
-        let mut elements: Vec<Element> = clusters.into_iter().map(|e| Element::fit(&strokes, e.strokes)).collect();
+        let mut elements: Vec<Element> = clusters
+            .into_iter()
+            .map(|e| Element::fit(&strokes, e.strokes))
+            .collect();
         if dim == Dim::One {
             elements.sort_by(|a, b| a.centre.x.total_cmp(&b.centre.x));
         }
@@ -173,7 +185,8 @@ impl PatternStyle {
             .iter()
             .map(|e| 2.0 * (e.axis.y.abs() * e.half_a + e.axis.x.abs() * e.half_b))
             .collect();
-        let dist = Distribution::analyse(elements.iter().map(|e| e.centre).collect(), &heights, dim);
+        let dist =
+            Distribution::analyse(elements.iter().map(|e| e.centre).collect(), &heights, dim);
         let reference = Reference::new(elements, dist, params.rings);
         Ok(PatternStyle {
             example: path.to_path_buf(),
@@ -313,10 +326,9 @@ pub fn synthesize_sketch(opts: &PatternOptions, sk: &Sketch) -> Result<PatternOu
         .enumerate()
         .map(|(qi, q)| {
             let name = q.style.as_deref().unwrap_or(&opts.style);
-            let style = styles
-                .get(name)
-                .cloned()
-                .ok_or_else(|| Error::invalid(&sk.path, format!("{}: style {name} not loaded", q.id)))?;
+            let style = styles.get(name).cloned().ok_or_else(|| {
+                Error::invalid(&sk.path, format!("{}: style {name} not loaded", q.id))
+            })?;
             let key = [opts.seed, qi as u64];
             let elements = match &q.kind {
                 QueryKind::Path { spine, width } => along_path(&style, spine, *width, opts, &key),
@@ -378,7 +390,9 @@ pub fn along_path(
         let k = [key, &[li as u64]].concat();
         let assigned = synth::synthesize(r, &target, &k);
         let half = width / 2.0;
-        let placed = synth::vary(r, &target, &assigned, opts.variation, &k, &|p: Point| p.y.abs() <= half);
+        let placed = synth::vary(r, &target, &assigned, opts.variation, &k, &|p: Point| {
+            p.y.abs() <= half
+        });
         for p in placed {
             let t = line.tangent(p.pos.x, spacing / 2.0);
             let normal = Vec2::new(-t.y, t.x);
@@ -410,7 +424,11 @@ pub fn in_region(
     let mut points: Vec<Point> = if (squeeze - 1.0).abs() < 1e-9 {
         seeds::lloyd(region, n, rng::hash(key), style.params.lloyd_iterations).points
     } else {
-        let squeezed = Region::new(&(Affine::scale_non_uniform(1.0, squeeze) * outline.clone()), region.rule, 0.05)?;
+        let squeezed = Region::new(
+            &(Affine::scale_non_uniform(1.0, squeeze) * outline.clone()),
+            region.rule,
+            0.05,
+        )?;
         seeds::lloyd(&squeezed, n, rng::hash(key), style.params.lloyd_iterations).points
     };
     for p in &mut points {
@@ -419,7 +437,10 @@ pub fn in_region(
     // Squeezing back can land a seed outside only through the two
     // flattenings' difference (≤ 0.1 units); such a seed is dropped whole.
     points.retain(|&p| region.contains(p));
-    let squeezed_pts: Vec<Point> = points.iter().map(|p| Point::new(p.x, p.y * squeeze)).collect();
+    let squeezed_pts: Vec<Point> = points
+        .iter()
+        .map(|p| Point::new(p.x, p.y * squeeze))
+        .collect();
     let graph = Graph::delaunay(&squeezed_pts);
     let target = Target {
         graph,
@@ -428,15 +449,22 @@ pub fn in_region(
         dim: Dim::Two,
     };
     let assigned = synth::synthesize(r, &target, key);
-    let placed = synth::vary(r, &target, &assigned, opts.variation, key, &|p| region.contains(p));
-    Ok(placed.into_iter().map(|p| place(style, p, p.pos, 0.0)).collect())
+    let placed = synth::vary(r, &target, &assigned, opts.variation, key, &|p| {
+        region.contains(p)
+    });
+    Ok(placed
+        .into_iter()
+        .map(|p| place(style, p, p.pos, 0.0))
+        .collect())
 }
 
 /// The rigid transform putting reference element `p.element`'s centre at
 /// `at`, turned by `angle + p.rotation`.
 fn place(style: &PatternStyle, p: Placed, at: Point, angle: f64) -> PlacedElement {
     let c = style.reference.elements[p.element].centre;
-    let transform = Affine::translate(at.to_vec2()) * Affine::rotate(angle + p.rotation) * Affine::translate(-c.to_vec2());
+    let transform = Affine::translate(at.to_vec2())
+        * Affine::rotate(angle + p.rotation)
+        * Affine::translate(-c.to_vec2());
     PlacedElement {
         element: p.element,
         transform,

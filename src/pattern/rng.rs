@@ -12,7 +12,9 @@ fn mix(mut z: u64) -> u64 {
 
 /// A 64-bit hash of the key words, in order.
 pub fn hash(words: &[u64]) -> u64 {
-    words.iter().fold(0x6A09_E667_F3BC_C909, |h, &w| mix(h ^ mix(w)))
+    words
+        .iter()
+        .fold(0x6A09_E667_F3BC_C909, |h, &w| mix(h ^ mix(w)))
 }
 
 /// A uniform number in [0, 1) from the key words.

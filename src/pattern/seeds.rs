@@ -91,7 +91,10 @@ impl Region {
             return Err("outline has non-finite coordinates".into());
         }
         if let Some(p) = first_crossing(&rings_pts) {
-            return Err(format!("outline is self-intersecting near ({:.1}, {:.1})", p.x, p.y));
+            return Err(format!(
+                "outline is self-intersecting near ({:.1}, {:.1})",
+                p.x, p.y
+            ));
         }
         let mut rings: Vec<Ring> = rings_pts
             .into_iter()
@@ -100,7 +103,9 @@ impl Region {
                 if polygon_area(&pos) < 0.0 {
                     pos.reverse();
                 }
-                let bbox = drawn.iter().fold(Rect::from_points(drawn[0], drawn[0]), |r, &p| r.union_pt(p));
+                let bbox = drawn
+                    .iter()
+                    .fold(Rect::from_points(drawn[0], drawn[0]), |r, &p| r.union_pt(p));
                 Ring {
                     drawn,
                     pos,
@@ -109,7 +114,11 @@ impl Region {
                 }
             })
             .collect();
-        let bbox = rings.iter().map(|r| r.bbox).reduce(|a, b| a.union(b)).unwrap_or(Rect::ZERO);
+        let bbox = rings
+            .iter()
+            .map(|r| r.bbox)
+            .reduce(|a, b| a.union(b))
+            .unwrap_or(Rect::ZERO);
         let mut region = Region {
             rings: Vec::new(),
             rule,
@@ -148,7 +157,7 @@ impl Region {
         // Rings with sign 0 stay: they still count in the winding number.
         region.area = rings.iter().map(|r| r.sign * polygon_area(&r.pos)).sum();
         region.rings = rings;
-        if !(region.area > 0.0) || region.area < (tolerance * tolerance) {
+        if region.area.is_nan() || region.area < (tolerance * tolerance).max(1e-12) {
             return Err("region has zero area".into());
         }
         Ok(region)
@@ -169,7 +178,9 @@ impl Region {
     /// Area, first moments and polar second moment about `z` of the part of
     /// the convex polygon `cell` (positive orientation) inside the region.
     pub fn moments_in(&self, cell: &[Point], z: Point) -> Moments {
-        let cb = cell.iter().fold(Rect::from_points(cell[0], cell[0]), |r, &p| r.union_pt(p));
+        let cb = cell
+            .iter()
+            .fold(Rect::from_points(cell[0], cell[0]), |r, &p| r.union_pt(p));
         let mut m = Moments::default();
         for r in &self.rings {
             if r.sign == 0.0 || !overlaps(r.bbox, cb) {
@@ -219,7 +230,9 @@ fn first_crossing(rings: &[Vec<Point>]) -> Option<Point> {
     }
     let bb = edges
         .iter()
-        .fold(Rect::from_points(edges[0].2, edges[0].2), |r, e| r.union_pt(e.2).union_pt(e.3));
+        .fold(Rect::from_points(edges[0].2, edges[0].2), |r, e| {
+            r.union_pt(e.2).union_pt(e.3)
+        });
     let cells = ((edges.len() as f64).sqrt().ceil() as usize).clamp(1, 512);
     let cw = (bb.width() / cells as f64).max(1e-12);
     let ch = (bb.height() / cells as f64).max(1e-12);
@@ -252,7 +265,7 @@ fn first_crossing(rings: &[Vec<Point>]) -> Option<Point> {
                 }
                 if let Some(p) = proper_crossing(ea.2, ea.3, eb.2, eb.3) {
                     let key = (a.min(b), a.max(b), p);
-                    if best.is_none_or(|bst| (key.0, key.1) < (bst.0, bst.1)) {
+                    if best.map_or(true, |bst| (key.0, key.1) < (bst.0, bst.1)) {
                         best = Some(key);
                     }
                 }
@@ -378,7 +391,10 @@ pub fn voronoi_cells(pts: &[Point], bbox: Rect) -> Vec<Vec<Point>> {
             idx,
         })
         .collect();
-    for (k, (dx, dy)) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)].into_iter().enumerate() {
+    for (k, (dx, dy)) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+        .into_iter()
+        .enumerate()
+    {
         verts.push(Indexed {
             pos: Point2::new(c.x + dx * r, c.y + dy * r),
             idx: n + k,
@@ -414,7 +430,10 @@ pub fn lloyd(region: &Region, n: usize, seed: u64, max_iter: usize) -> Lloyd {
     let mut pts = initial_seeds(region, n, seed);
     let mut energy = Vec::new();
     if pts.is_empty() {
-        return Lloyd { points: pts, energy };
+        return Lloyd {
+            points: pts,
+            energy,
+        };
     }
     let spacing = (region.area / pts.len() as f64).sqrt();
     let mut last_inside = pts.clone();
@@ -454,7 +473,10 @@ pub fn lloyd(region: &Region, n: usize, seed: u64, max_iter: usize) -> Lloyd {
             *p = *q;
         }
     }
-    Lloyd { points: pts, energy }
+    Lloyd {
+        points: pts,
+        energy,
+    }
 }
 
 /// A random start: one jittered point per cell of a grid sized for about n
@@ -466,7 +488,10 @@ pub fn initial_seeds(region: &Region, n: usize, seed: u64) -> Vec<Point> {
     }
     let bb = region.bbox;
     let g = (region.area / n as f64).sqrt() * 0.95;
-    let (nx, ny) = ((bb.width() / g).ceil() as u64, (bb.height() / g).ceil() as u64);
+    let (nx, ny) = (
+        (bb.width() / g).ceil() as u64,
+        (bb.height() / g).ceil() as u64,
+    );
     let mut cand: Vec<(u64, Point)> = Vec::new();
     if nx.saturating_mul(ny) <= 64 * n as u64 + 1024 {
         for iy in 0..ny {
@@ -539,11 +564,7 @@ impl Polyline {
                 closed = false;
                 cur.push(p);
             }
-            PathEl::LineTo(p) => {
-                if cur.last() != Some(&p) {
-                    cur.push(p);
-                }
-            }
+            PathEl::LineTo(p) if cur.last() != Some(&p) => cur.push(p),
             PathEl::ClosePath => {
                 if let (Some(&f), Some(&l)) = (cur.first(), cur.last()) {
                     if f != l {
@@ -568,8 +589,15 @@ impl Polyline {
     /// The point at arc length `s` (wrapped when closed, clamped when open).
     pub fn at(&self, s: f64) -> Point {
         let l = self.length();
-        let s = if self.closed { s.rem_euclid(l) } else { s.clamp(0.0, l) };
-        let i = self.cum.partition_point(|&c| c <= s).clamp(1, self.pts.len() - 1);
+        let s = if self.closed {
+            s.rem_euclid(l)
+        } else {
+            s.clamp(0.0, l)
+        };
+        let i = self
+            .cum
+            .partition_point(|&c| c <= s)
+            .clamp(1, self.pts.len() - 1);
         let (c0, c1) = (self.cum[i - 1], self.cum[i]);
         let t = if c1 > c0 { (s - c0) / (c1 - c0) } else { 0.0 };
         self.pts[i - 1].lerp(self.pts[i], t)

@@ -89,7 +89,13 @@ impl Measures {
         let (la, lb) = (a.length().max(floor), b.length().max(floor));
         let ov = (la / lb).max(lb / la);
         let sup = (a.thickness() - b.thickness()).abs();
-        let col = a.color.iter().zip(b.color).map(|(x, y)| (x - y) * (x - y)).sum::<f64>().sqrt();
+        let col = a
+            .color
+            .iter()
+            .zip(b.color)
+            .map(|(x, y)| (x - y) * (x - y))
+            .sum::<f64>()
+            .sqrt();
         Measures {
             shape,
             par,
@@ -101,13 +107,17 @@ impl Measures {
 
     /// col ∧ (shape ∨ (par ∧ ov ∧ sup)).
     pub fn similar(&self, t: &Thresholds) -> bool {
-        self.col < t.col && (self.shape < t.shape || (self.par < t.par && self.ov < t.ov && self.sup < t.sup))
+        self.col < t.col
+            && (self.shape < t.shape || (self.par < t.par && self.ov < t.ov && self.sup < t.sup))
     }
 
     /// σ-normalized error, for the fallback when nothing is similar.
     pub fn error(&self, t: &Thresholds) -> f64 {
-        let geo = (self.shape / t.shape.max(1e-12))
-            .min(self.par / t.par + (self.ov - 1.0) / (t.ov - 1.0).max(1e-12) + self.sup / t.sup.max(1e-12));
+        let geo = (self.shape / t.shape.max(1e-12)).min(
+            self.par / t.par
+                + (self.ov - 1.0) / (t.ov - 1.0).max(1e-12)
+                + self.sup / t.sup.max(1e-12),
+        );
         // A colour mismatch outweighs any geometric one.
         geo + 100.0 * (self.col / t.col).max(1.0) * (self.col >= t.col) as u8 as f64
     }
@@ -397,7 +407,8 @@ pub fn vary(
             let nb = &target.graph.adj[i];
             if nb.len() >= k {
                 if let Some(s_ref) = reference.dist.shift[placed.element] {
-                    let bary = nb.iter().fold(Vec2::ZERO, |s, &j| s + target.offset(i, j)) / nb.len() as f64;
+                    let bary = nb.iter().fold(Vec2::ZERO, |s, &j| s + target.offset(i, j))
+                        / nb.len() as f64;
                     let a_ref = reference.dist.graph.hood_area[placed.element];
                     let a_tar = target.graph.hood_area[i];
                     let n_ref = reference.dist.graph.adj[placed.element].len() as f64;

@@ -135,27 +135,42 @@ impl StyleToml {
         }
         if let Some(d) = self.dimension {
             if d != 1 && d != 2 {
-                return bad("dimension", format!("must be 1 (a row) or 2 (a field), got {d}"));
+                return bad(
+                    "dimension",
+                    format!("must be 1 (a row) or 2 (a field), got {d}"),
+                );
             }
         }
         if let Some(n) = self.lloyd_iterations {
             if !(1..=1000).contains(&n) {
-                return bad("lloyd_iterations", format!("must be within 1..1000, got {n}"));
+                return bad(
+                    "lloyd_iterations",
+                    format!("must be within 1..1000, got {n}"),
+                );
             }
         }
         for (i, ex) in self.exemplar.iter().enumerate() {
             if ex.file.is_absolute()
-                || ex.file.components().any(|c| matches!(c, std::path::Component::ParentDir))
+                || ex
+                    .file
+                    .components()
+                    .any(|c| matches!(c, std::path::Component::ParentDir))
             {
                 return bad(
                     &format!("exemplar[{i}].file"),
-                    format!("{} must be a path inside the style folder", ex.file.display()),
+                    format!(
+                        "{} must be a path inside the style folder",
+                        ex.file.display()
+                    ),
                 );
             }
         }
         if self.kind == StyleKind::Pattern {
             if self.scale.is_none() {
-                return bad("scale", "missing; a pattern style needs scale = ε (e.g. 12.0)".into());
+                return bad(
+                    "scale",
+                    "missing; a pattern style needs scale = ε (e.g. 12.0)".into(),
+                );
             }
             if self.exemplar.len() != 1 {
                 return bad(
@@ -175,7 +190,11 @@ impl StyleToml {
         if self.kind != kind {
             return Err(Error::invalid(
                 path.join(STYLE_FILE),
-                format!("kind: is \"{}\", this command needs \"{}\"", self.kind.name(), kind.name()),
+                format!(
+                    "kind: is \"{}\", this command needs \"{}\"",
+                    self.kind.name(),
+                    kind.name()
+                ),
             ));
         }
         Ok(())
@@ -226,14 +245,31 @@ mod tests {
     #[test]
     fn bad_values_name_file_and_key() {
         for (text, key) in [
-            ("kind = \"pattern\"\nscale = -1.0\n[[exemplar]]\nfile = \"a.svg\"\n", "scale"),
-            ("kind = \"pattern\"\nscale = nan\n[[exemplar]]\nfile = \"a.svg\"\n", "scale"),
-            ("kind = \"pattern\"\n[[exemplar]]\nfile = \"a.svg\"\n", "scale"),
-            ("kind = \"pattern\"\nscale = 2.0\nrings = 9\n[[exemplar]]\nfile = \"a.svg\"\n", "rings"),
+            (
+                "kind = \"pattern\"\nscale = -1.0\n[[exemplar]]\nfile = \"a.svg\"\n",
+                "scale",
+            ),
+            (
+                "kind = \"pattern\"\nscale = nan\n[[exemplar]]\nfile = \"a.svg\"\n",
+                "scale",
+            ),
+            (
+                "kind = \"pattern\"\n[[exemplar]]\nfile = \"a.svg\"\n",
+                "scale",
+            ),
+            (
+                "kind = \"pattern\"\nscale = 2.0\nrings = 9\n[[exemplar]]\nfile = \"a.svg\"\n",
+                "rings",
+            ),
             ("kind = \"pattern\"\nscale = 2.0\nbogus = 1\n", "bogus"),
-            ("kind = \"pattern\"\nscale = 2.0\n[[exemplar]]\nfile = \"../x.svg\"\n", "exemplar[0].file"),
+            (
+                "kind = \"pattern\"\nscale = 2.0\n[[exemplar]]\nfile = \"../x.svg\"\n",
+                "exemplar[0].file",
+            ),
         ] {
-            let e = parse(Path::new("s/style.toml"), text).unwrap_err().to_string();
+            let e = parse(Path::new("s/style.toml"), text)
+                .unwrap_err()
+                .to_string();
             assert!(e.starts_with("s/style.toml: "), "{e}");
             assert!(e.contains(key), "{e}");
             assert!(!e.contains('\n'), "{e}");
