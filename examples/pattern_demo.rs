@@ -53,11 +53,11 @@ fn main() -> flourish::Result<()> {
             let n: usize = doc.groups.iter().map(|g| g.shapes.len()).sum();
             println!("  {name}: {n} shapes in {ms:.1} ms");
         }
-        // The same along the wave with variation, to show §3.3.
+        // The region again with variation 0.5, to show §3.3.
         let opts = PatternOptions {
             style: style.into(),
             styles_dir: root.join("styles"),
-            variation: 1.0,
+            variation: 0.5,
             ..Default::default()
         };
         let doc = pattern::run(&opts, &samples.join("blob.svg"))?;

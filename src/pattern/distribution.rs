@@ -15,6 +15,7 @@
 use kurbo::{Point, Vec2};
 use spade::{DelaunayTriangulation, HasPosition, Point2, Triangulation};
 use std::collections::{BTreeSet, VecDeque};
+use std::f64::consts::{FRAC_PI_2, PI};
 
 /// Whether a distribution is a row or a field.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -240,10 +241,14 @@ impl Distribution {
         } else {
             nearest_spacing(&centres).unwrap_or(1.0)
         };
+        // Only surrounded elements have a meaningful shift: at the border
+        // of the example the neighbours all lie on one side and the
+        // "displacement" would just point outward.
         let shift = (0..n)
             .map(|i| {
                 let a = &graph.adj[i];
-                (!a.is_empty()).then(|| {
+                let offsets = a.iter().map(|&j| centres[j] - centres[i]);
+                surrounded(offsets, dim).then(|| {
                     a.iter()
                         .fold(Vec2::ZERO, |s, &j| s + (centres[i] - centres[j]))
                 })
@@ -268,6 +273,26 @@ impl Distribution {
             shift,
             spacing,
             area,
+        }
+    }
+}
+
+/// True when neighbours at `offsets` surround their element: in 1-D one
+/// on each side, in 2-D no angular gap between them wider than 0.8π.
+pub fn surrounded(offsets: impl Iterator<Item = Vec2>, dim: Dim) -> bool {
+    let mut angles: Vec<f64> = offsets.map(|o| o.y.atan2(o.x)).collect();
+    match dim {
+        Dim::One => {
+            angles.iter().any(|a| a.abs() < FRAC_PI_2) && angles.iter().any(|a| a.abs() > FRAC_PI_2)
+        }
+        Dim::Two => {
+            if angles.len() < 3 {
+                return false;
+            }
+            angles.sort_by(f64::total_cmp);
+            let wrap = angles[0] + 2.0 * PI - angles[angles.len() - 1];
+            let max_gap = angles.windows(2).map(|w| w[1] - w[0]).fold(wrap, f64::max);
+            max_gap < 0.8 * PI
         }
     }
 }

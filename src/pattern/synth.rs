@@ -29,7 +29,7 @@
 //! (k = 2 in 1-D, 4 in 2-D) moves by t of the way to the barycentre of its
 //! neighbours plus S_ref·A_tar/(n·A_ref).
 
-use super::distribution::{Dim, Distribution, Graph};
+use super::distribution::{surrounded, Dim, Distribution, Graph};
 use super::element::{directed_hausdorff, Element};
 use super::rng;
 use kurbo::{Point, Vec2};
@@ -405,7 +405,10 @@ pub fn vary(
             }
             // Position: barycentre of the neighbours plus the reference shift.
             let nb = &target.graph.adj[i];
-            if nb.len() >= k {
+            // The barycentre of a one-sided neighbourhood (at the region's
+            // border, a path's ends) lies inward: such elements stay put.
+            let around = surrounded(nb.iter().map(|&j| target.offset(i, j)), target.dim);
+            if nb.len() >= k && around {
                 if let Some(s_ref) = reference.dist.shift[placed.element] {
                     let bary = nb.iter().fold(Vec2::ZERO, |s, &j| s + target.offset(i, j))
                         / nb.len() as f64;
