@@ -179,7 +179,7 @@ fn samples(dir: &Path) -> std::io::Result<()> {
         &svg(
             640.0,
             220.0,
-            "  <path d=\"M40 150C140 20 240 20 320 110S500 200 600 70\" fill=\"none\" stroke=\"#888\" stroke-width=\"24\"/>\n",
+            "  <path d=\"M40 150C140 20 240 20 320 110S500 200 600 70\" fill=\"none\" stroke=\"#888\" stroke-width=\"36\"/>\n",
         ),
     )?;
     // A closed blob with a round hole: a region query with a hole.

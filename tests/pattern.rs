@@ -614,3 +614,41 @@ fn golden_outputs() {
         .to_svg();
     check_golden("mixed.svg", &text);
 }
+
+#[test]
+fn a_wide_band_is_filled_in_path_coordinates() {
+    use kurbo::ParamCurveNearest;
+    // The wave is 36 wide: more than two stipple spacings, so stipples fill
+    // the band at the example's density instead of making a single file.
+    let sk = sketch::load(&sample("wave")).unwrap();
+    let QueryKind::Path { spine, width } = &sk.queries[0].kind else {
+        panic!("wave is a path")
+    };
+    let out = flourish::pattern::synthesize_sketch(&opts("stipple"), &sk).unwrap();
+    let q = &out.queries[0];
+    let expected = q.style.expected_in_area(spine.perimeter(0.01) * width);
+    let got = q.elements.len() as f64;
+    assert!(
+        (got - expected).abs() <= 0.1 * expected,
+        "{got} vs {expected}"
+    );
+    let mut off_path = 0;
+    for e in &q.elements {
+        let d = spine
+            .segments()
+            .map(|s| s.nearest(e.centre, 1e-6).distance_sq.sqrt())
+            .fold(f64::MAX, f64::min);
+        assert!(
+            d <= width / 2.0 + 1e-6,
+            "centre {:?} is {d} off the spine",
+            e.centre
+        );
+        if d > 0.25 * width {
+            off_path += 1;
+        }
+    }
+    assert!(
+        off_path * 4 > q.elements.len(),
+        "the band is not filled across: {off_path}"
+    );
+}

@@ -31,7 +31,7 @@ use crate::style::{self, FitPoints, StyleKind};
 use crate::svg_out::{Document, Group, Shape};
 use distribution::{Dim, Distribution, Graph};
 use element::{Element, ExampleStroke};
-use kurbo::{Affine, Point, Rect, Vec2};
+use kurbo::{Affine, Point, Rect, Shape as _, Vec2};
 use rayon::prelude::*;
 use seeds::{Polyline, Region};
 use std::collections::BTreeMap;
@@ -363,8 +363,15 @@ fn too_many(n: f64, limit: usize) -> std::result::Result<(), String> {
     Ok(())
 }
 
-/// 1-D synthesis along every subpath of `spine`; the band is the stroke
-/// width: variation never moves a centre farther than width/2 off the path.
+/// Synthesis along every subpath of `spine` within the band of the stroke
+/// width.
+///
+/// When the band holds fewer than 1.5 rows of elements (rows = width /
+/// pitch; 2 rows for a row example), it is 1-D: seeds in a chain at the example's spacing, elements
+/// turned with the path, variation never moving a centre more than width/2
+/// off the path. A wider band is filled in 2-D in path coordinates (arc
+/// length, offset): the band is straightened into a length × width
+/// rectangle, synthesized like a region and bent back along the path.
 pub fn along_path(
     style: &PatternStyle,
     spine: &kurbo::BezPath,
@@ -375,24 +382,45 @@ pub fn along_path(
     let r = &style.reference;
     let spacing = r.dist.spacing;
     let lines = Polyline::from_path(spine, 0.05);
-    let total: f64 = lines.iter().map(|l| l.length() / spacing).sum();
+    // A row example is meant as a row: it stacks only when two fit.
+    let rows = width / r.dist.pitch;
+    let band = match r.dist.dim {
+        Dim::One => rows >= 2.0,
+        Dim::Two => rows >= 1.5,
+    };
+    let total: f64 = lines
+        .iter()
+        .map(|l| {
+            if band {
+                style.expected_in_area(l.length() * width)
+            } else {
+                l.length() / spacing
+            }
+        })
+        .sum();
     too_many(total, opts.max_elements)?;
+    let half = width / 2.0;
     let mut out = Vec::new();
     for (li, line) in lines.iter().enumerate() {
-        let s = seeds::seeds_along(line, spacing);
-        let closed = line.closed;
-        let target = Target {
-            pos: s.iter().map(|&x| Point::new(x, 0.0)).collect(),
-            graph: Graph::chain(&s, closed, line.length()),
-            period: closed.then(|| line.length()),
-            dim: Dim::One,
-        };
         let k = [key, &[li as u64]].concat();
-        let assigned = synth::synthesize(r, &target, &k);
-        let half = width / 2.0;
-        let placed = synth::vary(r, &target, &assigned, opts.variation, &k, &|p: Point| {
-            p.y.abs() <= half
-        });
+        let placed = if band {
+            let rect = Rect::new(0.0, -half, line.length(), half).to_path(0.1);
+            let region = Region::new(&rect, crate::svg_out::FillRule::NonZero, 0.05)?;
+            fill(style, &region, &rect, opts, &k)?
+        } else {
+            let s = seeds::seeds_along(line, spacing);
+            let closed = line.closed;
+            let target = Target {
+                pos: s.iter().map(|&x| Point::new(x, 0.0)).collect(),
+                graph: Graph::chain(&s, closed, line.length()),
+                period: closed.then(|| line.length()),
+                dim: Dim::One,
+            };
+            let assigned = synth::synthesize(r, &target, &k);
+            synth::vary(r, &target, &assigned, opts.variation, &k, &|p: Point| {
+                p.y.abs() <= half
+            })
+        };
         for p in placed {
             let t = line.tangent(p.pos.x, spacing / 2.0);
             let normal = Vec2::new(-t.y, t.x);
@@ -403,12 +431,8 @@ pub fn along_path(
     Ok(out)
 }
 
-/// 2-D synthesis inside `region`: N_tar = N_ref·A_tar/A_ref Lloyd seeds.
-///
-/// A row example fills a region with rows: Lloyd runs in a space squeezed
-/// across the rows by spacing/pitch, where the CVT is isotropic, and the
-/// seeds are stretched back — an anisotropic CVT with the row's spacing
-/// along x and its pitch along y.
+/// 2-D synthesis inside `region` (whose curves are `outline`): N_tar =
+/// N_ref·A_tar/A_ref Lloyd seeds, matched and varied.
 pub fn in_region(
     style: &PatternStyle,
     region: &Region,
@@ -416,6 +440,25 @@ pub fn in_region(
     opts: &PatternOptions,
     key: &[u64],
 ) -> std::result::Result<Vec<PlacedElement>, String> {
+    Ok(fill(style, region, outline, opts, key)?
+        .into_iter()
+        .map(|p| place(style, p, p.pos, 0.0))
+        .collect())
+}
+
+/// The 2-D pipeline in the pattern frame.
+///
+/// A row example fills a region with rows: Lloyd runs in a space squeezed
+/// across the rows by spacing/pitch, where the CVT is isotropic, and the
+/// seeds are stretched back — an anisotropic CVT with the row's spacing
+/// along x and its pitch along y.
+fn fill(
+    style: &PatternStyle,
+    region: &Region,
+    outline: &kurbo::BezPath,
+    opts: &PatternOptions,
+    key: &[u64],
+) -> std::result::Result<Vec<Placed>, String> {
     let r = &style.reference;
     let expected = style.expected_in_area(region.area);
     too_many(expected, opts.max_elements)?;
@@ -449,13 +492,14 @@ pub fn in_region(
         dim: Dim::Two,
     };
     let assigned = synth::synthesize(r, &target, key);
-    let placed = synth::vary(r, &target, &assigned, opts.variation, key, &|p| {
-        region.contains(p)
-    });
-    Ok(placed
-        .into_iter()
-        .map(|p| place(style, p, p.pos, 0.0))
-        .collect())
+    Ok(synth::vary(
+        r,
+        &target,
+        &assigned,
+        opts.variation,
+        key,
+        &|p| region.contains(p),
+    ))
 }
 
 /// The rigid transform putting reference element `p.element`'s centre at
