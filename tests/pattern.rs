@@ -652,3 +652,21 @@ fn a_wide_band_is_filled_in_path_coordinates() {
         "the band is not filled across: {off_path}"
     );
 }
+
+#[test]
+fn a_single_stroke_example_repeats_at_its_own_size() {
+    let d = temp_style(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"40\" height=\"40\"><path d=\"M10 20L30 20\" stroke=\"#000\" stroke-width=\"2\"/></svg>",
+        "scale = 4.0",
+    );
+    let sk = temp_sketch(d.path(), "<path d=\"M0 100L400 100\" fill=\"none\" stroke=\"#000\" stroke-width=\"4\"/><rect x=\"50\" y=\"150\" width=\"200\" height=\"100\" fill=\"#000\"/>");
+    let o = PatternOptions {
+        style: d.path().to_string_lossy().into(),
+        ..Default::default()
+    };
+    let out = flourish::pattern::synthesize_sketch(&o, &sketch::load(&sk).unwrap()).unwrap();
+    // 20 px long (butt caps) + ε 4 = 24 px apart: 400 / 24 ≈ 17.
+    assert_eq!(out.queries[0].elements.len(), 17);
+    let n2 = out.queries[1].elements.len();
+    assert!(n2 > 10 && n2 < 60, "{n2}");
+}

@@ -213,8 +213,14 @@ pub struct Distribution {
 impl Distribution {
     /// Analyses centres already expressed in the reference frame (for a
     /// row, x runs along it); `heights` are the elements' extents across
-    /// the row (along y).
-    pub fn analyse(centres: Vec<Point>, heights: &[f64], dim: Dim) -> Distribution {
+    /// the row (along y); `lone_spacing` is the spacing used when there is
+    /// no second element to measure one from.
+    pub fn analyse(
+        centres: Vec<Point>,
+        heights: &[f64],
+        dim: Dim,
+        lone_spacing: f64,
+    ) -> Distribution {
         let n = centres.len();
         let (graph, spacing) = match dim {
             Dim::One => {
@@ -239,7 +245,7 @@ impl Distribution {
         let spacing = if spacing > 0.0 {
             spacing
         } else {
-            nearest_spacing(&centres).unwrap_or(1.0)
+            nearest_spacing(&centres).unwrap_or(lone_spacing)
         };
         // Only surrounded elements have a meaningful shift: at the border
         // of the example the neighbours all lie on one side and the

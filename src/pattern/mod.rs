@@ -185,8 +185,18 @@ impl PatternStyle {
             .iter()
             .map(|e| 2.0 * (e.axis.y.abs() * e.half_a + e.axis.x.abs() * e.half_b))
             .collect();
-        let dist =
-            Distribution::analyse(elements.iter().map(|e| e.centre).collect(), &heights, dim);
+        // A lone element repeats at its own diameter plus ε.
+        let lone = elements
+            .iter()
+            .map(|e| e.length().max(e.thickness()))
+            .fold(0.0, f64::max)
+            + params.scale;
+        let dist = Distribution::analyse(
+            elements.iter().map(|e| e.centre).collect(),
+            &heights,
+            dim,
+            lone,
+        );
         let reference = Reference::new(elements, dist, params.rings);
         Ok(PatternStyle {
             example: path.to_path_buf(),
