@@ -667,6 +667,7 @@ fn a_single_stroke_example_repeats_at_its_own_size() {
     let out = flourish::pattern::synthesize_sketch(&o, &sketch::load(&sk).unwrap()).unwrap();
     // 20 px long (butt caps) + ε 4 = 24 px apart: 400 / 24 ≈ 17.
     assert_eq!(out.queries[0].elements.len(), 17);
+    // Rows of them, 24 px apart along a row and 2 + 24/2 = 14 px between rows.
     let n2 = out.queries[1].elements.len();
-    assert!(n2 > 10 && n2 < 60, "{n2}");
+    assert_eq!(n2, (200.0 * 100.0 / (24.0 * 14.0) as f64).round() as usize);
 }
