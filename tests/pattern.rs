@@ -669,5 +669,5 @@ fn a_single_stroke_example_repeats_at_its_own_size() {
     assert_eq!(out.queries[0].elements.len(), 17);
     // Rows of them, 24 px apart along a row and 2 + 24/2 = 14 px between rows.
     let n2 = out.queries[1].elements.len();
-    assert_eq!(n2, (200.0 * 100.0 / (24.0 * 14.0) as f64).round() as usize);
+    assert_eq!(n2, (200.0_f64 * 100.0 / (24.0 * 14.0)).round() as usize);
 }
