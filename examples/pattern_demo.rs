@@ -15,6 +15,51 @@ const STYLES: [&str; 4] = ["hatching", "stipple", "flowers", "brushmarks"];
 /// Samples run with every style (the `mixed` one names its own styles).
 const SAMPLES: [&str; 2] = ["wave", "blob"];
 
+/// The viewBox and the inner markup of an SVG document.
+fn parts(svg: &str) -> (String, String) {
+    let open_end = svg.find('>').map_or(0, |i| i + 1);
+    let head = &svg[..open_end];
+    let vb = head
+        .split("viewBox=\"")
+        .nth(1)
+        .and_then(|r| r.split('"').next())
+        .unwrap_or("0 0 100 100")
+        .to_string();
+    let body = svg[open_end..]
+        .trim_end()
+        .trim_end_matches("</svg>")
+        .to_string();
+    (vb, body)
+}
+
+/// Three documents side by side in framed 400 × 260 panels.
+fn strip(panels: &[String]) -> String {
+    let (w, h, pad) = (400.0, 260.0, 10.0);
+    let mut s = format!(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{}\" height=\"{}\">",
+        w * panels.len() as f64,
+        h
+    );
+    for (i, p) in panels.iter().enumerate() {
+        let (vb, body) = parts(p);
+        let x = i as f64 * w;
+        s += &format!(
+            "<rect x=\"{}\" y=\"{pad}\" width=\"{}\" height=\"{}\" fill=\"none\" stroke=\"#ccc\"/>",
+            x + pad / 2.0,
+            w - pad,
+            h - 2.0 * pad
+        );
+        s += &format!(
+            "<svg x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" viewBox=\"{vb}\">{body}</svg>",
+            x + 2.0 * pad,
+            2.0 * pad,
+            w - 4.0 * pad,
+            h - 4.0 * pad
+        );
+    }
+    s + "</svg>"
+}
+
 fn main() -> flourish::Result<()> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let out: PathBuf = std::env::args()
@@ -53,6 +98,15 @@ fn main() -> flourish::Result<()> {
             let n: usize = doc.groups.iter().map(|g| g.shapes.len()).sum();
             println!("  {name}: {n} shapes in {ms:.1} ms");
         }
+        // The README strip: example | along a path | inside a shape.
+        let panels = [
+            ex.clone(),
+            std::fs::read_to_string(out.join(format!("wave-{style}.svg")))
+                .map_err(|e| flourish::Error::io(&out, e))?,
+            std::fs::read_to_string(out.join(format!("blob-{style}.svg")))
+                .map_err(|e| flourish::Error::io(&out, e))?,
+        ];
+        write_preview(&strip(&panels), &out.join(format!("{style}-strip.png")))?;
         // The region again with variation 0.5, to show §3.3.
         let opts = PatternOptions {
             style: style.into(),
