@@ -445,3 +445,64 @@ pub fn wrap_half_turn(d: f64) -> f64 {
         r
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn bar(x: f64, angle: f64, len: f64, color: [f64; 3]) -> Element {
+        Element {
+            strokes: vec![],
+            centre: Point::new(x, 0.0),
+            axis: Vec2::new(angle.cos(), angle.sin()),
+            half_a: len / 2.0,
+            half_b: 0.5,
+            color,
+        }
+    }
+
+    #[test]
+    fn measures_follow_the_paper() {
+        let a = bar(0.0, 0.0, 10.0, [0.0; 3]);
+        let same = Measures::between(&a, &bar(50.0, PI, 10.0, [0.0; 3]), 1e-6);
+        assert!(same.shape < 1e-9 && same.par < 1e-9 && (same.ov - 1.0).abs() < 1e-9);
+        let turned = Measures::between(&a, &bar(0.0, PI / 2.0, 10.0, [0.0; 3]), 1e-6);
+        assert!((turned.par - PI / 2.0).abs() < 1e-9);
+        // Corner (5, 0.5) of one cross arm is 4.5 from the other arm.
+        assert!((turned.shape - 4.5).abs() < 1e-9, "{}", turned.shape);
+        let long = Measures::between(&a, &bar(0.0, 0.0, 20.0, [1.0, 0.0, 0.0]), 1e-6);
+        assert!((long.ov - 2.0).abs() < 1e-9);
+        assert!((long.col - 1.0).abs() < 1e-9);
+        let t = Thresholds::paper(10.0);
+        assert!(same.similar(&t));
+        assert!(!turned.similar(&t));
+        assert!(!long.similar(&t));
+    }
+
+    #[test]
+    fn matching_pairs_closest_neighbours_only() {
+        // A row of alternating colours: after a red, the candidates whose
+        // left neighbour is red are the blue ones.
+        let els: Vec<Element> = (0..8)
+            .map(|i| bar(i as f64 * 10.0, PI / 2.0, 6.0, [(i % 2) as f64, 0.0, 0.0]))
+            .collect();
+        let heights = vec![6.0; 8];
+        let dist = Distribution::analyse(
+            els.iter().map(|e| e.centre).collect(),
+            &heights,
+            Dim::One,
+            10.0,
+        );
+        let r = Reference::new(els, dist, 1);
+        // Known: element 2 (colour 0) one spacing to the left.
+        let known = [(2usize, Vec2::new(-10.0, 0.0))];
+        for cand in 1..8 {
+            let m = r.compare(cand, &known).unwrap();
+            assert_eq!(m.similar(&r.thresholds), cand % 2 == 1, "candidate {cand}");
+        }
+        // Element 0 has no left neighbour: nothing relevant to compare.
+        assert!(r.compare(0, &known).is_none());
+        // A neighbour far off the reference positions is not paired.
+        assert!(r.compare(3, &[(2, Vec2::new(-10.0, 30.0))]).is_none());
+    }
+}
