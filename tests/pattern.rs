@@ -671,3 +671,40 @@ fn a_single_stroke_example_repeats_at_its_own_size() {
     let n2 = out.queries[1].elements.len();
     assert_eq!(n2, (200.0_f64 * 100.0 / (24.0 * 14.0)).round() as usize);
 }
+
+#[test]
+fn smoothly_turning_marks_keep_turning_smoothly_along_a_path() {
+    // Fig. 5(c): each brush mark is turned π/16 from the last in the
+    // example; along a path, successive copies must keep small, steady steps.
+    let out = flourish::pattern::synthesize_sketch(
+        &opts("brushmarks"),
+        &sketch::load(&sample("wave")).unwrap(),
+    )
+    .unwrap();
+    let q = &out.queries[0];
+    let angles: Vec<f64> = q
+        .elements
+        .iter()
+        .map(|e| q.style.elements()[e.element].angle())
+        .collect();
+    let steps: Vec<f64> = angles
+        .windows(2)
+        .map(|w| flourish::pattern::synth::wrap_half_turn(w[1] - w[0]))
+        .collect();
+    let smooth = steps
+        .iter()
+        .filter(|d| d.abs() <= std::f64::consts::PI / 8.0)
+        .count();
+    assert!(steps.len() > 20);
+    assert!(
+        smooth * 10 >= steps.len() * 9,
+        "{smooth} of {} steps are smooth: {steps:?}",
+        steps.len()
+    );
+    // And it turns: the steps do not cancel out (one direction of turning).
+    let same_sign = steps
+        .iter()
+        .filter(|d| d.signum() == steps[steps.len() / 2].signum())
+        .count();
+    assert!(same_sign * 10 >= steps.len() * 8, "{steps:?}");
+}
