@@ -14,8 +14,11 @@
 pub mod diff;
 pub mod error;
 pub mod io;
+pub mod pattern;
 pub mod raster;
 pub mod render;
+pub mod sketch;
+pub mod style;
 pub mod svg_out;
 pub mod trace;
 

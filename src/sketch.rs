@@ -1,0 +1,390 @@
+//! Sketch SVG → queries.
+//!
+//! usvg resolves transforms, `use`, groups and units; this module walks the
+//! result and classifies every visible shape (SPEC.md, "Sketch SVG"):
+//! - a shape with a fill is a **region query** (its outline and fill rule);
+//! - a shape with a visible stroke and no fill is an **open query path**
+//!   (its geometry is the spine, its stroke width the intended width).
+//!
+//! A shape (or an ancestor group) may carry `data-style="NAME"`. usvg drops
+//! unknown attributes, so the raw XML is read first with roxmltree (the
+//! parser usvg itself uses) and shapes carrying a style without an `id` get
+//! a private one, mapped back here.
+//!
+//! Query geometry is in the sketch's user units (its `viewBox` space), so an
+//! output written with the sketch's `width`, `height` and `viewBox`
+//! overlays it exactly.
+
+use crate::error::{Error, Result};
+use crate::io;
+use crate::svg_out::FillRule;
+use kurbo::{Affine, BezPath, Rect, Shape as _};
+use resvg::usvg;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Prefix of the ids given to shapes that carry `data-style` but no `id`.
+const PRIVATE_ID: &str = "flourish-ds-";
+
+/// What a query asks for.
+#[derive(Clone, Debug, PartialEq)]
+pub enum QueryKind {
+    /// An open query path: decorate along `spine`.
+    Path {
+        /// The spine in user units (may hold several subpaths).
+        spine: BezPath,
+        /// The stroke width in user units: the intended pattern width.
+        width: f64,
+    },
+    /// A region query: decorate inside `outline`.
+    Region {
+        /// The outline in user units, holes included as subpaths.
+        outline: BezPath,
+        /// How the subpaths make the interior.
+        fill_rule: FillRule,
+    },
+}
+
+/// One thing in the sketch to decorate.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Query {
+    /// The element's own `id`, or `q-N` (N counting queries from 1).
+    pub id: String,
+    /// The `data-style` of the shape or its nearest ancestor, if any.
+    pub style: Option<String>,
+    /// Path or region, with its geometry.
+    pub kind: QueryKind,
+}
+
+/// A parsed sketch.
+#[derive(Clone, Debug)]
+pub struct Sketch {
+    /// The file it came from (for error messages).
+    pub path: PathBuf,
+    /// The `width` of the sketch, in user units of its viewport (px).
+    pub width: f64,
+    /// The `height` of the sketch, in px.
+    pub height: f64,
+    /// The sketch's `viewBox` (user units); `0 0 width height` when absent.
+    pub view_box: Rect,
+    /// The queries in document order.
+    pub queries: Vec<Query>,
+    /// Things ignored, one line each, for `--verbose`.
+    pub notes: Vec<String>,
+}
+
+/// Reads and parses a sketch SVG file.
+pub fn load(path: &Path) -> Result<Sketch> {
+    let data = io::read_file(path)?;
+    parse(path, &data)
+}
+
+/// Parses sketch SVG bytes; `path` names the file in errors.
+pub fn parse(path: &Path, data: &[u8]) -> Result<Sketch> {
+    let text = std::str::from_utf8(data).map_err(|_| Error::Svg {
+        path: path.to_path_buf(),
+        reason: "not UTF-8 text".into(),
+    })?;
+    let pre = preprocess(path, text)?;
+    let tree = io::parse_svg(path, pre.text.as_bytes())?;
+    let size = tree.size();
+    let (width, height) = (size.width() as f64, size.height() as f64);
+    let view_box = pre.view_box.unwrap_or(Rect::new(0.0, 0.0, width, height));
+    // usvg maps the viewBox onto the viewport; undo it so queries are in
+    // user units (SVG 1.1 §7.8, preserveAspectRatio).
+    let to_user = viewport_to_user(view_box, width, height, &pre.aspect);
+    let mut sketch = Sketch {
+        path: path.to_path_buf(),
+        width,
+        height,
+        view_box,
+        queries: Vec::new(),
+        notes: Vec::new(),
+    };
+    walk(tree.root(), to_user, &pre.styles, &mut sketch);
+    Ok(sketch)
+}
+
+/// Converts a tiny-skia path under transform `ts` into a kurbo path.
+pub fn to_bezpath(path: &usvg::tiny_skia_path::Path, ts: usvg::Transform) -> BezPath {
+    use usvg::tiny_skia_path::PathSegment;
+    let affine = Affine::new([
+        ts.sx as f64,
+        ts.ky as f64,
+        ts.kx as f64,
+        ts.sy as f64,
+        ts.tx as f64,
+        ts.ty as f64,
+    ]);
+    let p = |q: usvg::tiny_skia_path::Point| affine * kurbo::Point::new(q.x as f64, q.y as f64);
+    let mut out = BezPath::new();
+    for seg in path.segments() {
+        match seg {
+            PathSegment::MoveTo(a) => out.move_to(p(a)),
+            PathSegment::LineTo(a) => out.line_to(p(a)),
+            PathSegment::QuadTo(a, b) => out.quad_to(p(a), p(b)),
+            PathSegment::CubicTo(a, b, c) => out.curve_to(p(a), p(b), p(c)),
+            PathSegment::Close => out.close_path(),
+        }
+    }
+    out
+}
+
+/// The affine of a usvg transform.
+pub fn affine_of(ts: usvg::Transform) -> Affine {
+    Affine::new([
+        ts.sx as f64,
+        ts.ky as f64,
+        ts.kx as f64,
+        ts.sy as f64,
+        ts.tx as f64,
+        ts.ty as f64,
+    ])
+}
+
+/// Colour of a usvg paint: a flat colour as is, a gradient as the mean of
+/// its stops, a pattern as black.
+pub fn paint_color(paint: &usvg::Paint) -> crate::svg_out::Color {
+    use crate::svg_out::Color;
+    match paint {
+        usvg::Paint::Color(c) => Color::rgb(c.red, c.green, c.blue),
+        usvg::Paint::LinearGradient(g) => mean_stop(g.stops()),
+        usvg::Paint::RadialGradient(g) => mean_stop(g.stops()),
+        usvg::Paint::Pattern(_) => Color::BLACK,
+    }
+}
+
+fn mean_stop(stops: &[usvg::Stop]) -> crate::svg_out::Color {
+    if stops.is_empty() {
+        return crate::svg_out::Color::BLACK;
+    }
+    let n = stops.len() as f64;
+    let avg = |f: &dyn Fn(&usvg::Stop) -> u8| {
+        (stops.iter().map(|s| f(s) as f64).sum::<f64>() / n).round() as u8
+    };
+    crate::svg_out::Color::rgb(
+        avg(&|s| s.color().red),
+        avg(&|s| s.color().green),
+        avg(&|s| s.color().blue),
+    )
+}
+
+struct Preprocessed {
+    text: String,
+    view_box: Option<Rect>,
+    aspect: String,
+    /// element id → data-style
+    styles: BTreeMap<String, String>,
+}
+
+const SHAPES: [&str; 7] = [
+    "path", "rect", "circle", "ellipse", "line", "polyline", "polygon",
+];
+
+/// Reads `viewBox`, `preserveAspectRatio` and `data-style` from the raw XML
+/// and gives styled shapes without an id a private one.
+fn preprocess(path: &Path, text: &str) -> Result<Preprocessed> {
+    let opts = usvg::roxmltree::ParsingOptions {
+        allow_dtd: true,
+        ..Default::default()
+    };
+    let doc =
+        usvg::roxmltree::Document::parse_with_options(text, opts).map_err(|e| Error::Svg {
+            path: path.to_path_buf(),
+            reason: e.to_string(),
+        })?;
+    let root = doc.root_element();
+    let view_box = root.attribute("viewBox").and_then(parse_view_box);
+    let aspect = root
+        .attribute("preserveAspectRatio")
+        .unwrap_or("xMidYMid meet")
+        .to_string();
+    let mut styles = BTreeMap::new();
+    // (byte offset just after the tag name, id to insert)
+    let mut inserts: Vec<(usize, String)> = Vec::new();
+    for node in root.descendants().filter(|n| n.is_element()) {
+        if !SHAPES.contains(&node.tag_name().name()) {
+            continue;
+        }
+        let style = node
+            .ancestors()
+            .filter(|a| a.is_element())
+            .find_map(|a| a.attribute("data-style"));
+        let Some(style) = style else { continue };
+        let id = match node.attribute("id") {
+            Some(id) if !id.is_empty() => id.to_string(),
+            _ => {
+                let id = format!("{PRIVATE_ID}{}", inserts.len());
+                let start = node.range().start;
+                // `<` + tag name as written (with any prefix).
+                let tag_len = text[start + 1..]
+                    .find(|c: char| c.is_whitespace() || c == '/' || c == '>')
+                    .unwrap_or(0);
+                inserts.push((start + 1 + tag_len, id.clone()));
+                id
+            }
+        };
+        styles.insert(id, style.to_string());
+    }
+    let mut out = String::with_capacity(text.len() + inserts.len() * 24);
+    let mut last = 0;
+    for (at, id) in &inserts {
+        out.push_str(&text[last..*at]);
+        out.push_str(&format!(" id=\"{id}\""));
+        last = *at;
+    }
+    out.push_str(&text[last..]);
+    Ok(Preprocessed {
+        text: out,
+        view_box,
+        aspect,
+        styles,
+    })
+}
+
+fn parse_view_box(s: &str) -> Option<Rect> {
+    let v: Vec<f64> = s
+        .split(|c: char| c.is_whitespace() || c == ',')
+        .filter(|t| !t.is_empty())
+        .map(|t| t.parse::<f64>())
+        .collect::<Result<_, _>>()
+        .ok()?;
+    if v.len() != 4 || !v.iter().all(|x| x.is_finite()) || v[2] <= 0.0 || v[3] <= 0.0 {
+        return None;
+    }
+    Some(Rect::new(v[0], v[1], v[0] + v[2], v[1] + v[3]))
+}
+
+/// The inverse of the viewBox → viewport mapping of SVG 1.1 §7.8.
+fn viewport_to_user(vb: Rect, width: f64, height: f64, aspect: &str) -> Affine {
+    let (sx, sy) = (width / vb.width(), height / vb.height());
+    let words: Vec<&str> = aspect
+        .split_whitespace()
+        .filter(|w| *w != "defer")
+        .collect();
+    let align = words.first().copied().unwrap_or("xMidYMid");
+    let slice = words.get(1) == Some(&"slice");
+    let to_viewport = if align == "none" {
+        Affine::new([sx, 0.0, 0.0, sy, -vb.x0 * sx, -vb.y0 * sy])
+    } else {
+        let s = if slice { sx.max(sy) } else { sx.min(sy) };
+        let fx = if align.starts_with("xMin") {
+            0.0
+        } else if align.starts_with("xMax") {
+            1.0
+        } else {
+            0.5
+        };
+        let fy = if align.ends_with("YMin") {
+            0.0
+        } else if align.ends_with("YMax") {
+            1.0
+        } else {
+            0.5
+        };
+        let tx = -vb.x0 * s + (width - vb.width() * s) * fx;
+        let ty = -vb.y0 * s + (height - vb.height() * s) * fy;
+        Affine::new([s, 0.0, 0.0, s, tx, ty])
+    };
+    to_viewport.inverse()
+}
+
+fn walk(group: &usvg::Group, to_user: Affine, styles: &BTreeMap<String, String>, sk: &mut Sketch) {
+    for node in group.children() {
+        match node {
+            usvg::Node::Group(g) => walk(g, to_user, styles, sk),
+            usvg::Node::Image(_) => sk.notes.push("an image is ignored".into()),
+            usvg::Node::Text(_) => sk.notes.push("a text element is ignored".into()),
+            usvg::Node::Path(p) => add_path(p, to_user, styles, sk),
+        }
+    }
+}
+
+fn add_path(p: &usvg::Path, to_user: Affine, styles: &BTreeMap<String, String>, sk: &mut Sketch) {
+    let label = if p.id().is_empty() || p.id().starts_with(PRIVATE_ID) {
+        "an unnamed shape".to_string()
+    } else {
+        format!("shape {}", p.id())
+    };
+    if !p.is_visible() {
+        sk.notes.push(format!("{label} is invisible and ignored"));
+        return;
+    }
+    let abs = to_user * affine_of(p.abs_transform());
+    let geom = abs * to_bezpath(p.data(), usvg::Transform::identity());
+    if geom.elements().is_empty() || geom.bounding_box().area() == 0.0 && geom.perimeter(0.1) == 0.0
+    {
+        sk.notes
+            .push(format!("{label} has no geometry and is ignored"));
+        return;
+    }
+    let n = sk.queries.len() + 1;
+    let id = if p.id().is_empty() || p.id().starts_with(PRIVATE_ID) {
+        format!("q-{n}")
+    } else {
+        p.id().to_string()
+    };
+    let style = styles.get(p.id()).cloned();
+    if let Some(fill) = p.fill() {
+        let fill_rule = match fill.rule() {
+            usvg::FillRule::NonZero => FillRule::NonZero,
+            usvg::FillRule::EvenOdd => FillRule::EvenOdd,
+        };
+        sk.queries.push(Query {
+            id,
+            style,
+            kind: QueryKind::Region {
+                outline: geom,
+                fill_rule,
+            },
+        });
+    } else if let Some(stroke) = p.stroke() {
+        // Stroke width is scaled like lengths under the (near-uniform)
+        // transform: by the square root of its determinant.
+        let scale = abs.determinant().abs().sqrt();
+        let width = stroke.width().get() as f64 * scale;
+        if width.is_nan() || width <= 0.0 {
+            sk.notes
+                .push(format!("{label} has a zero stroke width and is ignored"));
+            return;
+        }
+        sk.queries.push(Query {
+            id,
+            style,
+            kind: QueryKind::Path { spine: geom, width },
+        });
+    } else {
+        sk.notes.push(format!(
+            "{label} has neither fill nor stroke and is ignored"
+        ));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn classifies_paths_and_regions() {
+        let svg = r##"<svg xmlns="http://www.w3.org/2000/svg" width="200" height="100" viewBox="0 0 400 200">
+            <path id="spine" d="M10 10 L300 10" stroke="#000" stroke-width="8" fill="none"/>
+            <g data-style="stipple"><rect x="10" y="50" width="100" height="100" fill="#f00"/></g>
+            <circle cx="300" cy="100" r="40" fill="none" stroke="none"/>
+        </svg>"##;
+        let s = parse(Path::new("t.svg"), svg.as_bytes()).unwrap();
+        assert_eq!(s.view_box, Rect::new(0.0, 0.0, 400.0, 200.0));
+        assert_eq!(s.queries.len(), 2);
+        assert_eq!(s.queries[0].id, "spine");
+        match &s.queries[0].kind {
+            QueryKind::Path { width, spine } => {
+                assert!((width - 8.0).abs() < 1e-4, "{width}");
+                let bb = spine.bounding_box();
+                assert!((bb.x1 - 300.0).abs() < 1e-3, "user units kept: {bb:?}");
+            }
+            k => panic!("{k:?}"),
+        }
+        assert_eq!(s.queries[1].id, "q-2");
+        assert_eq!(s.queries[1].style.as_deref(), Some("stipple"));
+        assert!(matches!(s.queries[1].kind, QueryKind::Region { .. }));
+    }
+}

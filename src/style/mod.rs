@@ -1,0 +1,278 @@
+//! Style libraries: a folder holding `style.toml` and its exemplar files.
+//!
+//! This module reads and validates `style.toml` ([`StyleToml`]) and finds a
+//! style folder from a `--style` argument ([`resolve`]). The analysis of the
+//! exemplars belongs to each mode (`pattern::PatternStyle` for patterns).
+//!
+//! Every error names the `style.toml` file and, where there is one, the key.
+
+use crate::error::{Error, Result};
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+
+/// The file name of a style's description inside its folder.
+pub const STYLE_FILE: &str = "style.toml";
+
+/// What a style library is for (`kind = "..."`).
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum StyleKind {
+    /// Decorative strokes along open paths.
+    Brush,
+    /// Art patterns inside closed shapes.
+    Fill,
+    /// Element patterns along paths and inside regions.
+    Pattern,
+}
+
+impl StyleKind {
+    /// The name used in `style.toml`.
+    pub fn name(self) -> &'static str {
+        match self {
+            StyleKind::Brush => "brush",
+            StyleKind::Fill => "fill",
+            StyleKind::Pattern => "pattern",
+        }
+    }
+}
+
+/// Which points an element's oriented box is fitted to (Barla et al. §2.1).
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum FitPoints {
+    /// The points of the stroke's centre line (the gesture).
+    Skeleton,
+    /// The points of the painted outline (stroke width and caps included).
+    #[default]
+    Contour,
+}
+
+/// One `[[exemplar]]` table.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ExemplarToml {
+    /// The exemplar file, relative to the style folder.
+    pub file: PathBuf,
+    /// Brush: spine start, in the exemplar's user units.
+    pub start: Option<[f64; 2]>,
+    /// Brush: spine end, in the exemplar's user units.
+    pub end: Option<[f64; 2]>,
+}
+
+/// The contents of `style.toml`. Fields that only some kinds use are
+/// optional here and checked by [`StyleToml::validate`] for the kind at hand.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct StyleToml {
+    /// `brush`, `fill` or `pattern`.
+    pub kind: StyleKind,
+    /// Raster modes: finest synthesis resolution of an exemplar, px (64..1024).
+    pub resolution: Option<u32>,
+    /// Raster modes: synthesize a signed distance field (true) or coverage.
+    pub sdf: Option<bool>,
+    /// The exemplar files.
+    #[serde(default)]
+    pub exemplar: Vec<ExemplarToml>,
+    /// Pattern: ε, the distance in the example's user units below which
+    /// strokes are perceived as one element (Barla et al. §2.2).
+    pub scale: Option<f64>,
+    /// Pattern: neighbourhood size in rings of the neighbour graph used
+    /// when matching (Barla et al. §3.1, 1..=6; default 2).
+    pub rings: Option<u32>,
+    /// Pattern: fit element boxes to the stroke `skeleton` or `contour`
+    /// (default `contour`).
+    pub fit: Option<FitPoints>,
+    /// Pattern: whether the example is a row (1) or a field (2) of
+    /// elements; detected from the element centres when absent.
+    pub dimension: Option<u8>,
+    /// Pattern: maximum Lloyd iterations for 2-D seeds (1..=1000; default 60).
+    pub lloyd_iterations: Option<u32>,
+}
+
+/// Parses `style.toml` text; `path` names the file in errors.
+pub fn parse(path: &Path, text: &str) -> Result<StyleToml> {
+    let parsed: StyleToml = toml::from_str(text).map_err(|e| {
+        // toml's own rendering spans several lines; keep one: line + message.
+        let line = e
+            .span()
+            .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
+        let msg = e.message().replace('\n', " ");
+        match line {
+            Some(l) => Error::invalid(path, format!("line {l}: {}", msg.trim())),
+            None => Error::invalid(path, msg.trim().to_string()),
+        }
+    })?;
+    parsed.validate(path)?;
+    Ok(parsed)
+}
+
+/// Reads and parses `dir/style.toml`.
+pub fn load(dir: &Path) -> Result<StyleToml> {
+    let path = dir.join(STYLE_FILE);
+    let bytes = crate::io::read_file(&path)?;
+    let text = String::from_utf8(bytes).map_err(|_| Error::invalid(&path, "not UTF-8 text"))?;
+    parse(&path, &text)
+}
+
+impl StyleToml {
+    /// Checks value ranges that serde cannot express; errors name the key.
+    pub fn validate(&self, path: &Path) -> Result<()> {
+        let bad = |key: &str, why: String| Err(Error::invalid(path, format!("{key}: {why}")));
+        if let Some(r) = self.resolution {
+            if !(64..=1024).contains(&r) {
+                return bad("resolution", format!("must be within 64..1024 px, got {r}"));
+            }
+        }
+        if let Some(s) = self.scale {
+            if !(s.is_finite() && s > 0.0) {
+                return bad("scale", format!("must be a positive number, got {s}"));
+            }
+        }
+        if let Some(r) = self.rings {
+            if !(1..=6).contains(&r) {
+                return bad("rings", format!("must be within 1..6, got {r}"));
+            }
+        }
+        if let Some(d) = self.dimension {
+            if d != 1 && d != 2 {
+                return bad(
+                    "dimension",
+                    format!("must be 1 (a row) or 2 (a field), got {d}"),
+                );
+            }
+        }
+        if let Some(n) = self.lloyd_iterations {
+            if !(1..=1000).contains(&n) {
+                return bad(
+                    "lloyd_iterations",
+                    format!("must be within 1..1000, got {n}"),
+                );
+            }
+        }
+        for (i, ex) in self.exemplar.iter().enumerate() {
+            if ex.file.is_absolute()
+                || ex
+                    .file
+                    .components()
+                    .any(|c| matches!(c, std::path::Component::ParentDir))
+            {
+                return bad(
+                    &format!("exemplar[{i}].file"),
+                    format!(
+                        "{} must be a path inside the style folder",
+                        ex.file.display()
+                    ),
+                );
+            }
+        }
+        if self.kind == StyleKind::Pattern {
+            if self.scale.is_none() {
+                return bad(
+                    "scale",
+                    "missing; a pattern style needs scale = ε (e.g. 12.0)".into(),
+                );
+            }
+            if self.exemplar.len() != 1 {
+                return bad(
+                    "exemplar",
+                    format!(
+                        "a pattern style takes exactly one example SVG, found {}",
+                        self.exemplar.len()
+                    ),
+                );
+            }
+        }
+        Ok(())
+    }
+
+    /// Fails unless the style is of `kind`.
+    pub fn expect_kind(&self, path: &Path, kind: StyleKind) -> Result<()> {
+        if self.kind != kind {
+            return Err(Error::invalid(
+                path.join(STYLE_FILE),
+                format!(
+                    "kind: is \"{}\", this command needs \"{}\"",
+                    self.kind.name(),
+                    kind.name()
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Finds a style folder: `style` itself when it is a folder holding
+/// `style.toml`, else `styles_dir/style` (the `--styles DIR` lookup).
+pub fn resolve(style: &str, styles_dir: &Path) -> Result<PathBuf> {
+    let direct = Path::new(style);
+    if direct.join(STYLE_FILE).is_file() {
+        return Ok(direct.to_path_buf());
+    }
+    let named = styles_dir.join(style);
+    if named.join(STYLE_FILE).is_file() {
+        return Ok(named);
+    }
+    Err(Error::invalid(
+        direct,
+        format!(
+            "style not found: neither {} nor {} exists",
+            direct.join(STYLE_FILE).display(),
+            named.join(STYLE_FILE).display()
+        ),
+    ))
+}
+
+/// The styles shipped with the tool (the crate's `styles/` folder).
+pub fn default_styles_dir() -> PathBuf {
+    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/styles"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pattern_style_parses() {
+        let s = parse(
+            Path::new("s/style.toml"),
+            "kind = \"pattern\"\nscale = 12.0\n[[exemplar]]\nfile = \"ex.svg\"\n",
+        )
+        .unwrap();
+        assert_eq!(s.kind, StyleKind::Pattern);
+        assert_eq!(s.scale, Some(12.0));
+    }
+
+    #[test]
+    fn bad_values_name_file_and_key() {
+        for (text, key) in [
+            (
+                "kind = \"pattern\"\nscale = -1.0\n[[exemplar]]\nfile = \"a.svg\"\n",
+                "scale",
+            ),
+            (
+                "kind = \"pattern\"\nscale = nan\n[[exemplar]]\nfile = \"a.svg\"\n",
+                "scale",
+            ),
+            (
+                "kind = \"pattern\"\n[[exemplar]]\nfile = \"a.svg\"\n",
+                "scale",
+            ),
+            (
+                "kind = \"pattern\"\nscale = 2.0\nrings = 9\n[[exemplar]]\nfile = \"a.svg\"\n",
+                "rings",
+            ),
+            ("kind = \"pattern\"\nscale = 2.0\nbogus = 1\n", "bogus"),
+            (
+                "kind = \"pattern\"\nscale = 2.0\n[[exemplar]]\nfile = \"../x.svg\"\n",
+                "exemplar[0].file",
+            ),
+        ] {
+            let e = parse(Path::new("s/style.toml"), text)
+                .unwrap_err()
+                .to_string();
+            assert!(e.starts_with("s/style.toml: "), "{e}");
+            assert!(e.contains(key), "{e}");
+            assert!(!e.contains('\n'), "{e}");
+        }
+    }
+}
