@@ -13,7 +13,9 @@ use std::hint::black_box;
 use std::path::Path;
 
 fn style(name: &str) -> PatternStyle {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("styles").join(name);
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("styles")
+        .join(name);
     match PatternStyle::load(&dir) {
         Ok(s) => s,
         Err(e) => panic!("{e}"),

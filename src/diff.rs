@@ -77,12 +77,19 @@ fn compare(a: &Pixmap, b: &Pixmap) -> DiffReport {
             let i = ((y * w + x) * 4) as usize;
             let pa = [da[i], da[i + 1], da[i + 2], da[i + 3]];
             let pb = [db[i], db[i + 1], db[i + 2], db[i + 3]];
-            let differs = pa.iter().zip(&pb).any(|(p, q)| p.abs_diff(*q) > CHANNEL_THRESHOLD);
+            let differs = pa
+                .iter()
+                .zip(&pb)
+                .any(|(p, q)| p.abs_diff(*q) > CHANNEL_THRESHOLD);
             changed += differs as u64;
             panels.put_pixel(x, y, image::Rgba(pa));
             panels.put_pixel(x + 2 * w, y, image::Rgba(pb));
             let grey = 255 - (255 - pa[0].min(pa[1]).min(pa[2])) / 4;
-            let m = if differs { [220, 0, 0, 255] } else { [grey, grey, grey, 255] };
+            let m = if differs {
+                [220, 0, 0, 255]
+            } else {
+                [grey, grey, grey, 255]
+            };
             panels.put_pixel(x + w, y, image::Rgba(m));
         }
     }

@@ -20,7 +20,10 @@ pub const MAX_PIXELS: u64 = 64 << 20;
 /// anything is allocated.
 pub fn check_canvas(path: &Path, width: u64, height: u64) -> Result<()> {
     if width == 0 || height == 0 {
-        return Err(Error::invalid(path, format!("empty canvas ({width}×{height} px)")));
+        return Err(Error::invalid(
+            path,
+            format!("empty canvas ({width}×{height} px)"),
+        ));
     }
     if width > MAX_SIDE || height > MAX_SIDE || width.saturating_mul(height) > MAX_PIXELS {
         return Err(Error::TooLarge {
@@ -42,7 +45,10 @@ pub fn read_file(path: &Path) -> Result<Vec<u8>> {
     if meta.len() > MAX_FILE_BYTES {
         return Err(Error::invalid(
             path,
-            format!("file of {} bytes exceeds the limit of {MAX_FILE_BYTES} bytes", meta.len()),
+            format!(
+                "file of {} bytes exceeds the limit of {MAX_FILE_BYTES} bytes",
+                meta.len()
+            ),
         ));
     }
     std::fs::read(path).map_err(|e| Error::io(path, e))

@@ -2,6 +2,7 @@
 //! reports. Exit status: 0 success, 1 failure, 2 usage error.
 
 use clap::{Args, Parser, Subcommand};
+use flourish::pattern::{self, PatternOptions};
 use flourish::raster::input::InputOptions;
 use flourish::trace::TraceOptions;
 use flourish::{diff, io, render, trace, Error};
@@ -11,7 +12,11 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "flourish", version, about = "Decorative SVGs from sketches, by example; bitmaps and SDFs to Bézier outlines.")]
+#[command(
+    name = "flourish",
+    version,
+    about = "Decorative SVGs from sketches, by example; bitmaps and SDFs to Bézier outlines."
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -30,8 +35,38 @@ struct Cli {
 enum Command {
     /// Trace bitmaps or SVGs into compact filled Bézier outlines.
     Trace(TraceArgs),
+    /// Arrange hand-drawn stroke elements along open paths and inside filled shapes.
+    Pattern(PatternArgs),
     /// Compare two SVGs by rendering; exit 1 when they differ beyond --tolerance.
     Diff(DiffArgs),
+}
+
+#[derive(Args)]
+struct PatternArgs {
+    /// Sketch SVGs: stroked paths get patterns along them, filled shapes inside them.
+    #[arg(required = true, value_name = "SKETCH.svg")]
+    sketches: Vec<PathBuf>,
+    /// Pattern style: a folder holding style.toml, or a name in --styles.
+    #[arg(long, default_value = "stipple")]
+    style: String,
+    /// Folder of named styles (default: the styles shipped with flourish).
+    #[arg(long, value_name = "DIR")]
+    styles: Option<PathBuf>,
+    /// Output SVG (`-` for standard output); one sketch only.
+    #[arg(short = 'o', long = "output", value_name = "OUT.svg")]
+    output: Option<PathBuf>,
+    /// Output folder for a batch: NAME.svg per sketch.
+    #[arg(long, value_name = "DIR", conflicts_with = "output")]
+    out_dir: Option<PathBuf>,
+    /// Render the result to a PNG (with --out-dir: a folder for NAME.png).
+    #[arg(long, value_name = "PNG")]
+    preview: Option<PathBuf>,
+    /// Random seed: the same seed gives the same output.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Amount of variation between repeated elements, 0..1.
+    #[arg(long, default_value_t = 0.0, value_name = "0..1")]
+    variation: f64,
 }
 
 #[derive(Args)]
@@ -130,6 +165,7 @@ fn run(cli: Cli) -> Result<(), Failure> {
     }
     match cli.command {
         Command::Trace(args) => run_trace(args, cli.quiet),
+        Command::Pattern(args) => run_pattern(args, cli.quiet, cli.verbose),
         Command::Diff(args) => run_diff(args, cli.quiet),
     }
 }
@@ -148,35 +184,108 @@ fn run_trace(args: TraceArgs, quiet: bool) -> Result<(), Failure> {
     if args.resolution == 0 {
         return Err(Failure::Usage("--resolution must be at least 1 px".into()));
     }
-    match (&args.output, &args.out_dir) {
-        (Some(out), None) => {
-            if args.inputs.len() != 1 {
-                return Err(Failure::Usage("-o takes one input; use --out-dir for several".into()));
+    let job = |inp: &Path| -> Result<String, Error> {
+        Ok(trace::trace_file(inp, &input, &opts)?.to_svg())
+    };
+    run_jobs(
+        &args.inputs,
+        args.output.as_deref(),
+        args.out_dir.as_deref(),
+        args.preview.as_deref(),
+        quiet,
+        &job,
+    )
+}
+
+fn run_pattern(args: PatternArgs, quiet: bool, verbose: bool) -> Result<(), Failure> {
+    if !(args.variation.is_finite() && (0.0..=1.0).contains(&args.variation)) {
+        return Err(Failure::Usage(format!(
+            "--variation {} is not in 0..=1",
+            args.variation
+        )));
+    }
+    let opts = PatternOptions {
+        style: args.style.clone(),
+        styles_dir: args
+            .styles
+            .clone()
+            .unwrap_or_else(flourish::style::default_styles_dir),
+        seed: args.seed,
+        variation: args.variation,
+        ..PatternOptions::default()
+    };
+    let job = |sketch: &Path| -> Result<String, Error> {
+        let sk = flourish::sketch::load(sketch)?;
+        if verbose {
+            for note in &sk.notes {
+                eprintln!("flourish: {}: {note}", sketch.display());
             }
-            let inp = &args.inputs[0];
+        }
+        Ok(pattern::synthesize_sketch(&opts, &sk)?
+            .to_document()
+            .to_svg())
+    };
+    run_jobs(
+        &args.sketches,
+        args.output.as_deref(),
+        args.out_dir.as_deref(),
+        args.preview.as_deref(),
+        quiet,
+        &job,
+    )
+}
+
+/// Runs `job` on one input (`-o`) or a batch (`--out-dir`, in parallel with
+/// a progress bar), writing each SVG and optional preview atomically.
+fn run_jobs(
+    inputs: &[PathBuf],
+    output: Option<&Path>,
+    out_dir: Option<&Path>,
+    preview: Option<&Path>,
+    quiet: bool,
+    job: &(dyn Fn(&Path) -> Result<String, Error> + Sync),
+) -> Result<(), Failure> {
+    match (output, out_dir) {
+        (Some(out), None) => {
+            if inputs.len() != 1 {
+                return Err(Failure::Usage(
+                    "-o takes one input; use --out-dir for several".into(),
+                ));
+            }
+            let inp = &inputs[0];
             check_not_input(inp, out)?;
-            if let Some(p) = &args.preview {
+            if let Some(p) = preview {
                 check_not_input(inp, p)?;
             }
-            let doc = trace::trace_file(inp, &input, &opts)?;
-            let svg = doc.to_svg();
+            let svg = job(inp)?;
             io::write_atomic(out, svg.as_bytes())?;
-            if let Some(p) = &args.preview {
+            if let Some(p) = preview {
                 render::write_preview(&svg, p)?;
             }
             Ok(())
         }
         (None, Some(dir)) => {
             if !dir.is_dir() {
-                return Err(Failure::Run(Error::invalid(dir, "output folder does not exist")));
+                return Err(Failure::Run(Error::invalid(
+                    dir,
+                    "output folder does not exist",
+                )));
+            }
+            if let Some(p) = preview {
+                if !p.is_dir() {
+                    return Err(Failure::Run(Error::invalid(
+                        p,
+                        "with --out-dir, --preview names an existing folder",
+                    )));
+                }
             }
             let mut names = std::collections::BTreeSet::new();
-            for inp in &args.inputs {
+            for inp in inputs {
                 let stem = inp.file_stem().unwrap_or_default().to_os_string();
                 if !names.insert(stem) {
                     return Err(Failure::Usage(format!(
-                        "two inputs would both write {}.svg",
-                        Path::new(inp.file_stem().unwrap_or_default()).display()
+                        "two inputs would both write {}",
+                        svg_name(inp).display()
                     )));
                 }
                 check_not_input(inp, &dir.join(svg_name(inp)))?;
@@ -184,22 +293,23 @@ fn run_trace(args: TraceArgs, quiet: bool) -> Result<(), Failure> {
             let bar = if quiet {
                 ProgressBar::hidden()
             } else {
-                let b = ProgressBar::new(args.inputs.len() as u64);
+                let b = ProgressBar::new(inputs.len() as u64);
                 if let Ok(style) = ProgressStyle::with_template("{bar:40} {pos}/{len} {msg}") {
                     b.set_style(style);
                 }
                 b
             };
-            let results: Vec<Result<(), Error>> = args
-                .inputs
+            let results: Vec<Result<(), Error>> = inputs
                 .par_iter()
                 .map(|inp| {
                     let r = (|| {
-                        let doc = trace::trace_file(inp, &input, &opts)?;
-                        let svg = doc.to_svg();
+                        let svg = job(inp)?;
                         io::write_atomic(&dir.join(svg_name(inp)), svg.as_bytes())?;
-                        if let Some(pdir) = &args.preview {
-                            let png = pdir.join(Path::new(inp.file_stem().unwrap_or_default()).with_extension("png"));
+                        if let Some(pdir) = preview {
+                            let png = pdir.join(
+                                Path::new(inp.file_stem().unwrap_or_default())
+                                    .with_extension("png"),
+                            );
                             render::write_preview(&svg, &png)?;
                         }
                         Ok(())
@@ -209,12 +319,12 @@ fn run_trace(args: TraceArgs, quiet: bool) -> Result<(), Failure> {
                 })
                 .collect();
             bar.finish_and_clear();
-            let mut failed = 0;
+            let mut failed = false;
             for e in results.into_iter().filter_map(|r| r.err()) {
                 eprintln!("flourish: {e}");
-                failed += 1;
+                failed = true;
             }
-            if failed > 0 {
+            if failed {
                 return Err(Failure::Differ);
             }
             Ok(())
@@ -229,14 +339,20 @@ fn svg_name(inp: &Path) -> PathBuf {
 
 fn check_not_input(input: &Path, output: &Path) -> Result<(), Failure> {
     if output.as_os_str() != "-" && io::same_file(input, output) {
-        return Err(Failure::Run(Error::invalid(output, "output would overwrite the input")));
+        return Err(Failure::Run(Error::invalid(
+            output,
+            "output would overwrite the input",
+        )));
     }
     Ok(())
 }
 
 fn run_diff(args: DiffArgs, quiet: bool) -> Result<(), Failure> {
     if !(args.tolerance.is_finite() && (0.0..=1.0).contains(&args.tolerance)) {
-        return Err(Failure::Usage(format!("--tolerance {} is not a fraction in 0..=1", args.tolerance)));
+        return Err(Failure::Usage(format!(
+            "--tolerance {} is not a fraction in 0..=1",
+            args.tolerance
+        )));
     }
     let report = diff::diff_files(&args.expected, &args.actual)?;
     if let Some(out) = &args.out {

@@ -337,7 +337,8 @@ impl DataWriter {
 /// Compact relative path data for `path` with `decimals` decimals.
 pub fn path_data(path: &BezPath, decimals: u32) -> String {
     let scale = 10f64.powi(decimals as i32);
-    let quant = |p: Point| -> (i64, i64) { ((p.x * scale).round() as i64, (p.y * scale).round() as i64) };
+    let quant =
+        |p: Point| -> (i64, i64) { ((p.x * scale).round() as i64, (p.y * scale).round() as i64) };
     // Half a quantum: control points this close to the chord make a line.
     let line_eps = 0.5 / scale;
     let mut w = DataWriter {
@@ -375,11 +376,33 @@ pub fn path_data(path: &BezPath, decimals: u32) -> String {
             PathEl::QuadTo(p1, p2) => {
                 let c1 = cur_pt + (p1 - cur_pt) * (2.0 / 3.0);
                 let c2 = p2 + (p1 - p2) * (2.0 / 3.0);
-                emit_cubic(&mut w, &mut cur, start, cur_pt, c1, c2, p2, &quant, line_eps, els.get(i + 1));
+                emit_cubic(
+                    &mut w,
+                    &mut cur,
+                    start,
+                    cur_pt,
+                    c1,
+                    c2,
+                    p2,
+                    &quant,
+                    line_eps,
+                    els.get(i + 1),
+                );
                 cur_pt = p2;
             }
             PathEl::CurveTo(p1, p2, p3) => {
-                emit_cubic(&mut w, &mut cur, start, cur_pt, p1, p2, p3, &quant, line_eps, els.get(i + 1));
+                emit_cubic(
+                    &mut w,
+                    &mut cur,
+                    start,
+                    cur_pt,
+                    p1,
+                    p2,
+                    p3,
+                    &quant,
+                    line_eps,
+                    els.get(i + 1),
+                );
                 cur_pt = p3;
             }
             PathEl::ClosePath => {

@@ -68,8 +68,8 @@ pub fn squared_edt(seed: &Grid<bool>) -> Grid<f32> {
     cols.par_chunks_mut(h).enumerate().for_each_init(
         || (vec![0.0f32; h], vec![0usize; h], vec![0.0f32; h + 1]),
         |(f, v, z), (x, col)| {
-            for y in 0..h {
-                f[y] = init.get(x, y);
+            for (y, fy) in f.iter_mut().enumerate() {
+                *fy = init.get(x, y);
             }
             dt_1d(f, col, v, z);
         },

@@ -130,7 +130,11 @@ fn load_raster(path: &Path, bytes: &[u8], opts: &InputOptions) -> Result<Ink> {
             h,
             px.iter()
                 .map(|p| {
-                    let c = if has_alpha { p[3] as f32 / 255.0 } else { 1.0 - luma(p) };
+                    let c = if has_alpha {
+                        p[3] as f32 / 255.0
+                    } else {
+                        1.0 - luma(p)
+                    };
                     if opts.invert {
                         1.0 - c
                     } else {
@@ -179,7 +183,13 @@ fn mean_ink_colour(px: &[[u8; 4]], cov: &Coverage) -> Color {
 /// (the paper colour, most common on the border, excluded), each pixel
 /// explained as a mix of its two nearest palette colours (anti-aliasing),
 /// and layer `k` covering its own colour and every colour stacked above it.
-fn quantized_layers(px: &[[u8; 4]], w: usize, h: usize, has_alpha: bool, invert: bool) -> Vec<(Color, Coverage)> {
+fn quantized_layers(
+    px: &[[u8; 4]],
+    w: usize,
+    h: usize,
+    has_alpha: bool,
+    invert: bool,
+) -> Vec<(Color, Coverage)> {
     // Composite over white so transparency reads as paper.
     let rgb: Vec<[f32; 3]> = px
         .iter()
@@ -188,20 +198,24 @@ fn quantized_layers(px: &[[u8; 4]], w: usize, h: usize, has_alpha: bool, invert:
             [0, 1, 2].map(|k| p[k] as f32 * a + 255.0 * (1.0 - a))
         })
         .collect();
-    let key = |c: &[f32; 3]| ((c[0] as u32 >> 4) << 8) | ((c[1] as u32 >> 4) << 4) | (c[2] as u32 >> 4);
+    let key =
+        |c: &[f32; 3]| ((c[0] as u32 >> 4) << 8) | ((c[1] as u32 >> 4) << 4) | (c[2] as u32 >> 4);
     let mut hist = std::collections::BTreeMap::<u32, (u64, [f64; 3])>::new();
     for c in &rgb {
         let e = hist.entry(key(c)).or_insert((0, [0.0; 3]));
         e.0 += 1;
-        for k in 0..3 {
-            e.1[k] += c[k] as f64;
+        for (sum, &v) in e.1.iter_mut().zip(c) {
+            *sum += v as f64;
         }
     }
     let mut bins: Vec<(u64, [f32; 3])> = hist
         .values()
         .map(|(n, s)| (*n, [0, 1, 2].map(|k| (s[k] / *n as f64) as f32)))
         .collect();
-    bins.sort_by(|a, b| b.0.cmp(&a.0).then(a.1.partial_cmp(&b.1).unwrap_or(std::cmp::Ordering::Equal)));
+    bins.sort_by(|a, b| {
+        b.0.cmp(&a.0)
+            .then(a.1.partial_cmp(&b.1).unwrap_or(std::cmp::Ordering::Equal))
+    });
     let min_count = ((w * h) as u64 / 500).max(1);
     let dist2 = |a: &[f32; 3], b: &[f32; 3]| (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f32>();
     let mut palette: Vec<[f32; 3]> = Vec::new();
@@ -221,11 +235,18 @@ fn quantized_layers(px: &[[u8; 4]], w: usize, h: usize, has_alpha: bool, invert:
             *border.entry(key(c)).or_default() += 1;
         }
     }
-    let paper_key = border.iter().max_by_key(|(k, n)| (**n, std::cmp::Reverse(**k))).map(|(k, _)| *k);
+    let paper_key = border
+        .iter()
+        .max_by_key(|(k, n)| (**n, std::cmp::Reverse(**k)))
+        .map(|(k, _)| *k);
     let paper = palette
         .iter()
         .position(|p| Some(key(p)) == paper_key)
-        .or_else(|| palette.iter().position(|p| dist2(p, &[255.0; 3]) < 48.0 * 48.0));
+        .or_else(|| {
+            palette
+                .iter()
+                .position(|p| dist2(p, &[255.0; 3]) < 48.0 * 48.0)
+        });
     let paper_colour = paper.map(|i| palette[i]).unwrap_or([255.0; 3]);
     if let Some(i) = paper {
         palette.remove(i);
@@ -279,10 +300,17 @@ fn quantized_layers(px: &[[u8; 4]], w: usize, h: usize, has_alpha: bool, invert:
             let above = &order[pos..];
             let cov = Grid::from_fn(w, h, |x, y| {
                 let i = y * w + x;
-                above.iter().map(|&m| weights[i * k + m]).sum::<f32>().min(1.0)
+                above
+                    .iter()
+                    .map(|&m| weights[i * k + m])
+                    .sum::<f32>()
+                    .min(1.0)
             });
             let c = palette[j];
-            (Color::rgb(c[0].round() as u8, c[1].round() as u8, c[2].round() as u8), cov)
+            (
+                Color::rgb(c[0].round() as u8, c[1].round() as u8, c[2].round() as u8),
+                cov,
+            )
         })
         .collect()
 }
@@ -299,8 +327,16 @@ struct SvgShape {
 fn paint_colour(paint: &usvg::Paint) -> Color {
     let c = match paint {
         usvg::Paint::Color(c) => *c,
-        usvg::Paint::LinearGradient(g) => g.stops().first().map(|s| s.color()).unwrap_or(usvg::Color::black()),
-        usvg::Paint::RadialGradient(g) => g.stops().first().map(|s| s.color()).unwrap_or(usvg::Color::black()),
+        usvg::Paint::LinearGradient(g) => g
+            .stops()
+            .first()
+            .map(|s| s.color())
+            .unwrap_or(usvg::Color::black()),
+        usvg::Paint::RadialGradient(g) => g
+            .stops()
+            .first()
+            .map(|s| s.color())
+            .unwrap_or(usvg::Color::black()),
         usvg::Paint::Pattern(_) => usvg::Color::black(),
     };
     Color::rgb(c.red, c.green, c.blue)
@@ -328,7 +364,11 @@ fn collect_shapes(group: &usvg::Group, canvas: tiny_skia::Transform, out: &mut V
                 }
                 if let Some(stroke) = p.stroke() {
                     if stroke.opacity().get() > 0.0 {
-                        let res = transform.get_scale().0.max(transform.get_scale().1).max(1e-3);
+                        let res = transform
+                            .get_scale()
+                            .0
+                            .max(transform.get_scale().1)
+                            .max(1e-3);
                         if let Some(outline) = p.data().stroke(&stroke.to_tiny_skia(), res) {
                             out.push(SvgShape {
                                 color: paint_colour(stroke.paint()),
@@ -348,7 +388,14 @@ fn collect_shapes(group: &usvg::Group, canvas: tiny_skia::Transform, out: &mut V
 /// A tiny-skia path as a kurbo path with `transform` applied.
 pub fn to_kurbo(path: &tiny_skia::Path, transform: tiny_skia::Transform) -> BezPath {
     let t = transform;
-    let affine = Affine::new([t.sx as f64, t.ky as f64, t.kx as f64, t.sy as f64, t.tx as f64, t.ty as f64]);
+    let affine = Affine::new([
+        t.sx as f64,
+        t.ky as f64,
+        t.kx as f64,
+        t.sy as f64,
+        t.tx as f64,
+        t.ty as f64,
+    ]);
     let pt = |p: tiny_skia::Point| Point::new(p.x as f64, p.y as f64);
     let mut out = BezPath::new();
     for seg in path.segments() {
@@ -409,7 +456,11 @@ struct FlatShape {
 impl FlatShape {
     fn new(shape: &SvgShape) -> Self {
         let mut segments = Vec::new();
-        flatten_segments(&to_kurbo(&shape.path, shape.transform), FLATTEN_PX, &mut segments);
+        flatten_segments(
+            &to_kurbo(&shape.path, shape.transform),
+            FLATTEN_PX,
+            &mut segments,
+        );
         let mut bbox = kurbo::Rect::new(f64::MAX, f64::MAX, f64::MIN, f64::MIN);
         for l in &segments {
             bbox = bbox.union_pt(l.p0).union_pt(l.p1);
@@ -485,7 +536,11 @@ fn scan_inside(w: usize, h: usize, shapes: &[FlatShape]) -> Grid<bool> {
             let mut wind = 0;
             for k in 0..row.len() - 1 {
                 wind += row[k].1;
-                let inside = if shape.even_odd { wind % 2 != 0 } else { wind != 0 };
+                let inside = if shape.even_odd {
+                    wind % 2 != 0
+                } else {
+                    wind != 0
+                };
                 if !inside {
                     continue;
                 }
@@ -513,7 +568,11 @@ fn union_boundary(shapes: &[FlatShape]) -> Vec<Line> {
             let others: Vec<&FlatShape> = shapes
                 .iter()
                 .enumerate()
-                .filter(|(j, o)| *j != i && o.bbox.intersect(shape.bbox).area() >= 0.0 && overlaps(o.bbox, shape.bbox))
+                .filter(|(j, o)| {
+                    *j != i
+                        && o.bbox.intersect(shape.bbox).area() >= 0.0
+                        && overlaps(o.bbox, shape.bbox)
+                })
                 .map(|(_, o)| o)
                 .collect();
             let lonely = others.is_empty();
@@ -572,13 +631,20 @@ fn load_svg(path: &Path, bytes: &[u8], opts: &InputOptions) -> Result<Ink> {
         (0..colours.len())
             .map(|k| {
                 let above = &colours[k..];
-                (colours[k], shapes.iter().filter(|s| above.contains(&s.color)).collect())
+                (
+                    colours[k],
+                    shapes.iter().filter(|s| above.contains(&s.color)).collect(),
+                )
             })
             .collect()
     } else if shapes.is_empty() && !opts.invert {
         Vec::new()
     } else {
-        let colour = if colours.len() == 1 && !opts.invert { colours[0] } else { Color::BLACK };
+        let colour = if colours.len() == 1 && !opts.invert {
+            colours[0]
+        } else {
+            Color::BLACK
+        };
         vec![(colour, shapes.iter().collect())]
     };
     let mut layers = Vec::new();

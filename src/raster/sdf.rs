@@ -127,7 +127,8 @@ fn distance_to_segments(inside: &Grid<bool>, segments: &[Line]) -> Grid<f32> {
     let mut buckets: Vec<Vec<u32>> = vec![Vec::new(); strips];
     for (i, l) in pieces.iter().enumerate() {
         let y0 = (l.p0.y.min(l.p1.y) - band - 0.5).floor().max(0.0) as usize / STRIP;
-        let y1 = ((l.p0.y.max(l.p1.y) + band - 0.5).ceil().max(0.0) as usize / STRIP).min(strips - 1);
+        let y1 =
+            ((l.p0.y.max(l.p1.y) + band - 0.5).ceil().max(0.0) as usize / STRIP).min(strips - 1);
         for b in buckets.iter_mut().take(y1 + 1).skip(y0) {
             b.push(i as u32);
         }
@@ -141,9 +142,11 @@ fn distance_to_segments(inside: &Grid<bool>, segments: &[Line]) -> Grid<f32> {
             for &i in &buckets[strip] {
                 let l = pieces[i as usize];
                 let x0 = (l.p0.x.min(l.p1.x) - band - 0.5).floor().max(0.0) as usize;
-                let x1 = ((l.p0.x.max(l.p1.x) + band - 0.5).ceil().max(0.0) as usize).min(w.saturating_sub(1));
+                let x1 = ((l.p0.x.max(l.p1.x) + band - 0.5).ceil().max(0.0) as usize)
+                    .min(w.saturating_sub(1));
                 let y0 = ((l.p0.y.min(l.p1.y) - band - 0.5).floor().max(0.0) as usize).max(row0);
-                let y1 = ((l.p0.y.max(l.p1.y) + band - 0.5).ceil().max(0.0) as usize).min(row0 + nrows - 1);
+                let y1 = ((l.p0.y.max(l.p1.y) + band - 0.5).ceil().max(0.0) as usize)
+                    .min(row0 + nrows - 1);
                 for y in y0..=y1 {
                     for x in x0..=x1 {
                         let p = Point::new(x as f64 + 0.5, y as f64 + 0.5);
@@ -163,7 +166,11 @@ fn distance_to_segments(inside: &Grid<bool>, segments: &[Line]) -> Grid<f32> {
         .enumerate()
         .map(|(i, &d)| {
             let is_in = inside.data()[i];
-            let far2 = if is_in { to_out.data()[i] } else { to_in.data()[i] };
+            let far2 = if is_in {
+                to_out.data()[i]
+            } else {
+                to_in.data()[i]
+            };
             let mag = if d <= BAND {
                 d
             } else if far2 >= FAR {
@@ -303,7 +310,13 @@ const SMOOTHING_ROUNDS: usize = 12;
 /// of `cov ≥ 0.5`), placed by the edge model, or smoothed along its link
 /// where the coverage is binary.
 pub fn subpixel_outline(cov: &Coverage) -> Vec<Vec<Point>> {
-    let values = cov.map(|c| if c >= 0.5 { (0.5 - c).min(-1e-6) } else { 0.5 - c });
+    let values = cov.map(|c| {
+        if c >= 0.5 {
+            (0.5 - c).min(-1e-6)
+        } else {
+            0.5 - c
+        }
+    });
     let contours = contour::extract(&values);
     contours
         .par_iter()
@@ -313,7 +326,8 @@ pub fn subpixel_outline(cov: &Coverage) -> Vec<Vec<Point>> {
             let n = t.len();
             if est.iter().any(|e| !e.1) {
                 for _ in 0..SMOOTHING_ROUNDS {
-                    let pts: Vec<Point> = c.links.iter().zip(&t).map(|(l, &t)| l.point(t)).collect();
+                    let pts: Vec<Point> =
+                        c.links.iter().zip(&t).map(|(l, &t)| l.point(t)).collect();
                     let mut next = t.clone();
                     for i in 0..n {
                         if est[i].1 {
@@ -377,7 +391,10 @@ mod tests {
                 let m = 200;
                 for a in 0..m {
                     for b in 0..m {
-                        let x = Vec2::new((a as f64 + 0.5) / m as f64 - 0.5, (b as f64 + 0.5) / m as f64 - 0.5);
+                        let x = Vec2::new(
+                            (a as f64 + 0.5) / m as f64 - 0.5,
+                            (b as f64 + 0.5) / m as f64 - 0.5,
+                        );
                         cnt += (n.dot(x) >= d) as u32;
                     }
                 }
@@ -456,8 +473,12 @@ mod tests {
                 Point::new(cx + r * a.cos(), cy + r * a.sin())
             })
             .collect();
-        let segs: Vec<Line> = (0..n).map(|i| Line::new(pts[i], pts[(i + 1) % n])).collect();
-        let inside = Grid::from_fn(30, 30, |x, y| (x as f64 + 0.5 - cx).hypot(y as f64 + 0.5 - cy) <= r);
+        let segs: Vec<Line> = (0..n)
+            .map(|i| Line::new(pts[i], pts[(i + 1) % n]))
+            .collect();
+        let inside = Grid::from_fn(30, 30, |x, y| {
+            (x as f64 + 0.5 - cx).hypot(y as f64 + 0.5 - cy) <= r
+        });
         let sdf = Sdf::from_segments(&inside, &segs, Affine::IDENTITY);
         let err = max_error_near_boundary(&sdf, |x, y| (x - cx).hypot(y - cy) - r);
         assert!(err <= 0.01, "max error {err}");
@@ -468,7 +489,13 @@ mod tests {
         // A binary half-plane with slope 1/4: the smoothed outline must be
         // close to the true line, closer than the raw midpoint polygon.
         let f = |x: f64, y: f64| y - (10.0 + 0.25 * x);
-        let cov = Grid::from_fn(40, 30, |x, y| if f(x as f64 + 0.5, y as f64 + 0.5) >= 0.0 { 1.0 } else { 0.0 });
+        let cov = Grid::from_fn(40, 30, |x, y| {
+            if f(x as f64 + 0.5, y as f64 + 0.5) >= 0.0 {
+                1.0
+            } else {
+                0.0
+            }
+        });
         let polys = subpixel_outline(&cov);
         assert_eq!(polys.len(), 1);
         let len = (1.0f64 + 0.0625).sqrt();

@@ -159,10 +159,26 @@ pub fn extract(values: &Grid<f32>) -> Vec<Contour> {
             // Cell edges in clockwise order (y down): top a→b, right b→c,
             // bottom c→d, left d→a.
             let edges = [
-                Link { horizontal: true, x, y },
-                Link { horizontal: false, x: x + 1, y },
-                Link { horizontal: true, x, y: y + 1 },
-                Link { horizontal: false, x, y },
+                Link {
+                    horizontal: true,
+                    x,
+                    y,
+                },
+                Link {
+                    horizontal: false,
+                    x: x + 1,
+                    y,
+                },
+                Link {
+                    horizontal: true,
+                    x,
+                    y: y + 1,
+                },
+                Link {
+                    horizontal: false,
+                    x,
+                    y,
+                },
             ];
             let corner = [a, b, c, d];
             let saddle = case == 5 || case == 10;
@@ -174,7 +190,7 @@ pub fn extract(values: &Grid<f32>) -> Vec<Contour> {
             // to the out→in edge that bounds the same region of the cell.
             for e in 0..4 {
                 let (from, to) = (corner[e], corner[(e + 1) % 4]);
-                if !(from && !to) {
+                if !from || to {
                     continue;
                 }
                 let partner = if saddle {
@@ -309,7 +325,16 @@ mod tests {
         // Two squares meeting diagonally at one sample corner: the saddle
         // rule must give the same answer wherever it is applied.
         let mut g = Grid::new(6, 6, 1.0f32);
-        for (x, y) in [(1, 1), (2, 1), (1, 2), (2, 2), (3, 3), (4, 3), (3, 4), (4, 4)] {
+        for (x, y) in [
+            (1, 1),
+            (2, 1),
+            (1, 2),
+            (2, 2),
+            (3, 3),
+            (4, 3),
+            (3, 4),
+            (4, 4),
+        ] {
             g.set(x, y, -1.0);
         }
         let cs = extract(&g);
@@ -329,7 +354,9 @@ mod tests {
         let cs = extract(&g);
         // Centres average to 0 → outside: every inside sample is its own island.
         assert_eq!(cs.len(), 32);
-        assert!(cs.iter().all(|c| c.signed_area() > 0.0 && c.points.len() == 4));
+        assert!(cs
+            .iter()
+            .all(|c| c.signed_area() > 0.0 && c.points.len() == 4));
         let g2 = g.map(|v| if v < 0.0 { -1.5 } else { 1.0 });
         let cs2 = extract(&g2);
         // Centres inside → all inside samples join into one region with holes.
@@ -346,7 +373,9 @@ mod tests {
         let c = &cs[0];
         check_clean(c);
         let ys: Vec<f64> = c.points.iter().map(|p| p.y).collect();
-        let (lo, hi) = ys.iter().fold((f64::MAX, f64::MIN), |(a, b), &y| (a.min(y), b.max(y)));
+        let (lo, hi) = ys
+            .iter()
+            .fold((f64::MAX, f64::MIN), |(a, b), &y| (a.min(y), b.max(y)));
         assert!((hi - lo - 1.0).abs() < 0.01, "{lo} {hi}");
     }
 

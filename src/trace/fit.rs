@@ -11,7 +11,8 @@
 
 use crate::raster::Sdf;
 use kurbo::{
-    Affine, BezPath, CubicBez, CurveFitSample, ParamCurve, ParamCurveArclen, ParamCurveFit, Point, Vec2,
+    Affine, BezPath, CubicBez, CurveFitSample, ParamCurve, ParamCurveArclen, ParamCurveFit, Point,
+    Vec2,
 };
 use std::ops::Range;
 
@@ -69,7 +70,11 @@ impl<'a> Piece<'a> {
             Err(i) => i.saturating_sub(1).min(n - 2),
         };
         let seg = self.cum[i + 1] - self.cum[i];
-        let t = if seg > 0.0 { (s - self.cum[i]) / seg } else { 0.0 };
+        let t = if seg > 0.0 {
+            (s - self.cum[i]) / seg
+        } else {
+            0.0
+        };
         (i, self.pts[i].lerp(self.pts[i + 1], t))
     }
 
@@ -291,7 +296,12 @@ const MAX_PIECE_TURN: f64 = std::f64::consts::FRAC_PI_2;
 fn split_by_turning<'a>(piece: &Piece<'a>) -> Vec<Piece<'a>> {
     let n = piece.pts.len();
     if n < 4 {
-        return vec![Piece::new(piece.pts.clone(), piece.sdf, piece.corner_start, piece.corner_end)];
+        return vec![Piece::new(
+            piece.pts.clone(),
+            piece.sdf,
+            piece.corner_start,
+            piece.corner_end,
+        )];
     }
     // Turning is accumulated between chords of about 3 px, which follow the
     // outline's shape and not the sub-pixel wobble of its vertices.
@@ -300,6 +310,7 @@ fn split_by_turning<'a>(piece: &Piece<'a>) -> Vec<Piece<'a>> {
     let mut anchor = 0usize;
     let mut prev_dir: Option<f64> = None;
     let mut total = 0.0;
+    #[allow(clippy::needless_range_loop)] // i indexes cum, pts and acc alike
     for i in 1..n {
         if piece.cum[i] - piece.cum[anchor] >= STEP || i == n - 1 {
             let d = (piece.pts[i] - piece.pts[anchor]).atan2();
@@ -388,7 +399,13 @@ fn fit_piece(piece: &Piece, accuracy: f64, out: &mut Vec<CubicBez>) {
 /// further but kept as a polygon.
 const MIN_SPAN_PX: f64 = 1.5;
 
-fn fit_range(piece: &Piece, range: Range<f64>, accuracy: f64, depth: u32, out: &mut Vec<(Range<f64>, CubicBez)>) {
+fn fit_range(
+    piece: &Piece,
+    range: Range<f64>,
+    accuracy: f64,
+    depth: u32,
+    out: &mut Vec<(Range<f64>, CubicBez)>,
+) {
     if let Some(c) = fit_checked(piece, range.clone(), accuracy) {
         out.push((range, c));
         return;
@@ -430,7 +447,8 @@ fn fit_checked(piece: &Piece, range: Range<f64>, accuracy: f64) -> Option<CubicB
     }
     let (c, _) = kurbo::fit_to_cubic(piece, range, accuracy)?;
     let c = Affine::translate(piece.origin) * c;
-    let ok = (1..16).all(|k| piece.sdf.value(c.eval(k as f64 / 16.0)).abs() <= accuracy + CHECK_SLACK)
+    let ok = (1..32)
+        .all(|k| piece.sdf.value(c.eval(k as f64 / 32.0)).abs() <= accuracy + CHECK_SLACK)
         && c.arclen(0.01) <= 1.5 * len + 0.5;
     ok.then_some(c)
 }
@@ -444,7 +462,9 @@ fn is_spicy(piece: &Piece, range: Range<f64>) -> bool {
     let step = (range.end - range.start) / (N - 1) as f64;
     let mut last: Option<Vec2> = None;
     for i in 0..N {
-        let t = piece.sample_pt_tangent(range.start + i as f64 * step, 1.0).tangent;
+        let t = piece
+            .sample_pt_tangent(range.start + i as f64 * step, 1.0)
+            .tangent;
         if let Some(l) = last {
             if t.cross(l).abs() > 0.2 * t.dot(l).abs() {
                 return true;
@@ -464,7 +484,9 @@ mod tests {
 
     pub(crate) fn disc_sdf(size: usize, cx: f64, cy: f64, r: f64) -> Sdf {
         Sdf {
-            dist: Grid::from_fn(size, size, |x, y| ((x as f64 + 0.5 - cx).hypot(y as f64 + 0.5 - cy) - r) as f32),
+            dist: Grid::from_fn(size, size, |x, y| {
+                ((x as f64 + 0.5 - cx).hypot(y as f64 + 0.5 - cy) - r) as f32
+            }),
             to_user: Affine::IDENTITY,
         }
     }

@@ -142,8 +142,16 @@ pub fn trace_sdf(sdf: &Sdf, opts: &TraceOptions) -> Vec<BezPath> {
 /// `<g id="layer-N">` per layer, bottom first.
 pub fn trace_ink(ink: &Ink, opts: &TraceOptions) -> Result<Document> {
     opts.validate()?;
-    let px_per_unit = ink.layers.first().map(|l| l.sdf.px_per_unit()).unwrap_or(1.0);
-    let mut doc = Document::new(ink.width, ink.height, decimals_for(opts.tolerance / px_per_unit));
+    let px_per_unit = ink
+        .layers
+        .first()
+        .map(|l| l.sdf.px_per_unit())
+        .unwrap_or(1.0);
+    let mut doc = Document::new(
+        ink.width,
+        ink.height,
+        decimals_for(opts.tolerance / px_per_unit),
+    );
     for (i, layer) in ink.layers.iter().enumerate() {
         let paths = trace_sdf(&layer.sdf, opts);
         if paths.is_empty() {

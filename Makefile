@@ -1,0 +1,52 @@
+# flourish — the project's entry points. See README.md.
+CARGO ?= cargo
+BIN := target/release/flourish
+OUT := out
+
+.PHONY: demo test golden bench lint deps clean
+
+# Everything the tests need that cargo does not install: potrace, the
+# reference tracer the trace tests compare against.
+deps:
+	@command -v potrace >/dev/null 2>&1 || { \
+	  echo "installing potrace (Debian package) for the comparison tests"; \
+	  (apt-get update -qq && apt-get install -y -qq potrace) >/dev/null 2>&1 || \
+	  (sudo apt-get update -qq && sudo apt-get install -y -qq potrace) >/dev/null 2>&1 || \
+	  echo "could not install potrace: the potrace comparison will be skipped (it fails under CI)"; }
+
+# The main job on the shipped samples: traces and patterns, with previews, into out/.
+demo:
+	$(CARGO) build --release
+	mkdir -p $(OUT)/trace $(OUT)/pattern
+	$(BIN) trace samples/trace/*.png samples/trace/*.svg --out-dir $(OUT)/trace --preview $(OUT)/trace
+	$(BIN) trace samples/trace/two-colour.svg --layers -o $(OUT)/trace/two-colour-layers.svg --preview $(OUT)/trace/two-colour-layers.png
+	for style in hatching stipple flowers brushmarks; do \
+	  for s in samples/pattern/*.svg; do \
+	    n=$$(basename $$s .svg); \
+	    $(BIN) pattern --style $$style $$s -o $(OUT)/pattern/$$n-$$style.svg --preview $(OUT)/pattern/$$n-$$style.png || exit 1; \
+	  done; \
+	done
+	@echo "demo outputs (SVG + preview PNG) are in $(OUT)/"
+
+# The whole test suite (heavy tests run optimized: see [profile.test]).
+test: deps
+	$(CARGO) test --all-targets
+	$(CARGO) test --doc
+
+# Regenerate the golden files; review the diff before committing.
+golden:
+	UPDATE_GOLDEN=1 $(CARGO) test --test trace golden
+	UPDATE_GOLDEN=1 $(CARGO) test --test pattern
+	git status --short golden/
+
+# Criterion benchmarks of every pipeline, then the side-by-side with potrace.
+bench: deps
+	$(CARGO) bench
+	$(CARGO) run --release --example compare_potrace
+
+lint:
+	$(CARGO) fmt --all -- --check
+	$(CARGO) clippy --all-targets -- -D warnings
+
+clean:
+	rm -rf $(OUT) golden/.failed

@@ -1,0 +1,175 @@
+//! Prints a markdown table comparing `flourish trace` (default options) with
+//! potrace (`potrace -s`, default options, on the 50 %-thresholded bitmap)
+//! on every sample in `samples/trace`: segments, max deviation from the
+//! vector ground truth (symmetric Hausdorff, px) and median time of 5 runs.
+//!
+//! ```text
+//! cargo run --release --example compare_potrace [-- RUNS]
+//! ```
+//!
+//! The measurement code is shared with `tests/potrace.rs`
+//! (`tests/support/mod.rs`, where the ground truth and the distance are
+//! documented). flourish is timed in-process (`trace_file`, PNG decoding
+//! included); potrace as a process (wall clock, PBM already written).
+
+#[path = "../tests/support/mod.rs"]
+mod support;
+
+fn main() {
+    if !support::potrace_available() {
+        eprintln!("potrace not found: apt-get install potrace");
+        std::process::exit(1);
+    }
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.first().map(String::as_str) == Some("--explain") {
+        let name = args.get(1).expect("--explain NAME.png OUTDIR");
+        let dir = std::path::PathBuf::from(args.get(2).map(String::as_str).unwrap_or("."));
+        explain(name, &dir);
+        return;
+    }
+    let runs: usize = args.first().and_then(|s| s.parse().ok()).unwrap_or(5);
+    let mut names: Vec<String> = std::fs::read_dir(support::root().join("samples/trace"))
+        .expect("samples/trace")
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().to_string())
+        .filter(|n| n.ends_with(".png"))
+        .collect();
+    names.sort();
+    println!("Median of {runs} runs; deviations are symmetric Hausdorff distances (px) to the SVG ground truth; IoU: rendered output vs 50 %-thresholded input.\n");
+    println!("| file | size | flourish segments | potrace segments | segment ratio | flourish max dev | potrace max dev | flourish median ms | potrace median ms | time ratio | flourish IoU | potrace IoU |");
+    println!("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    let (mut fs, mut ps) = (0usize, 0usize);
+    for name in &names {
+        let c = support::compare(name, runs);
+        fs += c.flourish_segments;
+        ps += c.potrace_segments;
+        let fms = c.flourish_time.as_secs_f64() * 1e3;
+        let pms = c.potrace_time.as_secs_f64() * 1e3;
+        println!(
+            "| {} | {}x{} | {} | {} | {:.3} | {:.3} ({:.2}/{:.2}) | {:.3} ({:.2}/{:.2}) | {:.1} | {:.1} | {:.2} | {:.4} | {:.4} |",
+            c.name,
+            c.width,
+            c.height,
+            c.flourish_segments,
+            c.potrace_segments,
+            c.flourish_segments as f64 / c.potrace_segments as f64,
+            c.flourish_dev,
+            c.flourish_dev_dir.0,
+            c.flourish_dev_dir.1,
+            c.potrace_dev,
+            c.potrace_dev_dir.0,
+            c.potrace_dev_dir.1,
+            fms,
+            pms,
+            fms / pms,
+            c.flourish_iou,
+            c.potrace_iou,
+        );
+    }
+    println!(
+        "\nAll samples: flourish {fs} segments, potrace {ps} (ratio {:.3}). Max dev in parentheses: (output→truth / truth→output). Ratios are flourish / potrace.",
+        fs as f64 / ps as f64
+    );
+}
+
+/// `--explain NAME.png OUTDIR`: where each tracer deviates most. Prints the
+/// worst points of both directions and the truth regions missed by more
+/// than 1.5 px, and writes 8× magnified crops around them
+/// (`OUTDIR/NAME-K.png`: input bitmap grey, truth green, flourish red,
+/// potrace blue).
+fn explain(name: &str, dir: &std::path::Path) {
+    use kurbo::{Point, Rect};
+    use resvg::tiny_skia;
+    std::fs::create_dir_all(dir).unwrap();
+    let png = support::sample(name);
+    let bitmap = image::open(&png).unwrap().to_luma8();
+    let truth = support::ground_truth(&support::truth_svg_for(&png));
+    let (doc, _) = support::run_flourish(&png, 1);
+    std::fs::write(dir.join(format!("{name}.flourish.svg")), doc.to_svg()).unwrap();
+    let fpaths = support::doc_paths(&doc);
+    let (ppaths, _, _) = support::run_potrace(&bitmap, 1);
+    let mut spots: Vec<(String, Point)> = Vec::new();
+    for (label, paths) in [("flourish", &fpaths), ("potrace", &ppaths)] {
+        let ((a, pa), (b, pb)) = support::worst_points(paths, &truth);
+        println!("{label}: output→truth {a:.3} px at ({:.1}, {:.1}); truth→output {b:.3} px at ({:.1}, {:.1})", pa.x, pa.y, pb.x, pb.y);
+        spots.push((format!("{label} out→truth {a:.2}"), pa));
+        spots.push((format!("{label} truth→out {b:.2}"), pb));
+        let far = support::far_truth_points(paths, &truth, 1.5, 24.0);
+        println!(
+            "  {} truth regions (24 px cells) farther than 1.5 px from {label}; worst:",
+            far.len()
+        );
+        for (d, p) in far.iter().take(8) {
+            println!("    {d:.2} px at ({:.1}, {:.1})", p.x, p.y);
+        }
+        for (d, p) in far.iter().take(3) {
+            spots.push((format!("{label} missed {d:.2}"), *p));
+        }
+    }
+    let flat_f = support::flatten_paths(&fpaths);
+    let flat_p = support::flatten_paths(&ppaths);
+    for (k, (label, c)) in spots.iter().enumerate() {
+        let z = 8.0f32;
+        let half = 24.0;
+        let view = Rect::new(c.x - half, c.y - half, c.x + half, c.y + half);
+        let side = (2.0 * half as f32 * z) as u32;
+        let mut pm = tiny_skia::Pixmap::new(side, side).unwrap();
+        pm.fill(tiny_skia::Color::WHITE);
+        let mut paint = tiny_skia::Paint::default();
+        paint.set_color_rgba8(200, 200, 200, 255);
+        for y in view.y0.floor().max(0.0) as u32..(view.y1.ceil() as u32).min(bitmap.height()) {
+            for x in view.x0.floor().max(0.0) as u32..(view.x1.ceil() as u32).min(bitmap.width()) {
+                if bitmap.get_pixel(x, y)[0] < 128 {
+                    let r = tiny_skia::Rect::from_xywh(
+                        (x as f64 - view.x0) as f32 * z,
+                        (y as f64 - view.y0) as f32 * z,
+                        z,
+                        z,
+                    );
+                    if let Some(r) = r {
+                        pm.fill_rect(r, &paint, tiny_skia::Transform::identity(), None);
+                    }
+                }
+            }
+        }
+        for (lines, rgb, w) in [
+            (&truth, (0, 160, 0), 3.0),
+            (&flat_f, (220, 0, 0), 1.5),
+            (&flat_p, (0, 0, 255), 1.5),
+        ] {
+            let mut pb = tiny_skia::PathBuilder::new();
+            for l in lines.iter() {
+                if !(view.contains(l.p0) || view.contains(l.p1)) {
+                    continue;
+                }
+                pb.move_to(
+                    ((l.p0.x - view.x0) as f32) * z,
+                    ((l.p0.y - view.y0) as f32) * z,
+                );
+                pb.line_to(
+                    ((l.p1.x - view.x0) as f32) * z,
+                    ((l.p1.y - view.y0) as f32) * z,
+                );
+            }
+            if let Some(path) = pb.finish() {
+                let mut paint = tiny_skia::Paint::default();
+                paint.set_color_rgba8(rgb.0, rgb.1, rgb.2, 255);
+                paint.anti_alias = true;
+                let stroke = tiny_skia::Stroke {
+                    width: w,
+                    ..Default::default()
+                };
+                pm.stroke_path(
+                    &path,
+                    &paint,
+                    &stroke,
+                    tiny_skia::Transform::identity(),
+                    None,
+                );
+            }
+        }
+        let out = dir.join(format!("{name}-{k}.png"));
+        pm.save_png(&out).unwrap();
+        println!("{}: {label} around ({:.1}, {:.1})", out.display(), c.x, c.y);
+    }
+}

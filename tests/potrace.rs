@@ -1,0 +1,193 @@
+//! flourish against potrace on the binary samples: flourish must be at
+//! least as accurate (symmetric Hausdorff distance to the vector ground
+//! truth) and at least as compact (segments), and its output must
+//! reproduce the input bitmap (IoU ≥ 0.99 after rendering and 50 %
+//! thresholding).
+//!
+//! Needs the `potrace` binary (Debian package `potrace`): when it is
+//! missing the test fails under `CI`, else it is skipped loudly.
+//! Figures go to stderr: `cargo test --release --test potrace -- --nocapture`.
+
+mod support;
+
+use support::compare;
+
+const BINARY_SAMPLES: [&str; 4] = [
+    "glyph-a-binary.png",
+    "ornament-scroll-binary.png",
+    "thin-lines-binary.png",
+    "ornament-2mp.png",
+];
+
+/// The target: at least as accurate and as compact as potrace on
+/// every binary sample. Not met yet (flourish has 1.3–6× potrace's
+/// segments, and drops diagonal one-pixel lines); run with `--ignored`.
+#[test]
+#[ignore = "target not yet met: segment counts 1.3-6x potrace's; see README benchmark table"]
+fn flourish_beats_potrace_on_binary_samples() {
+    if !support::potrace_available() {
+        let msg =
+            "potrace not found: install it (apt-get install potrace) to compare flourish with it";
+        if std::env::var_os("CI").is_some() {
+            panic!("{msg}");
+        }
+        eprintln!("\n!!!!!!!! SKIPPED flourish_beats_potrace_on_binary_samples: {msg} !!!!!!!!\n");
+        return;
+    }
+    let mut failures = Vec::new();
+    for name in BINARY_SAMPLES {
+        let c = compare(name, 1);
+        eprintln!(
+            "{name} ({}x{}): segments flourish {} / potrace {} | max deviation flourish {:.3} px (out→truth {:.3}, truth→out {:.3}) / potrace {:.3} px (out→truth {:.3}, truth→out {:.3}) | IoU flourish {:.5} / potrace {:.5}",
+            c.width,
+            c.height,
+            c.flourish_segments,
+            c.potrace_segments,
+            c.flourish_dev,
+            c.flourish_dev_dir.0,
+            c.flourish_dev_dir.1,
+            c.potrace_dev,
+            c.potrace_dev_dir.0,
+            c.potrace_dev_dir.1,
+            c.flourish_iou,
+            c.potrace_iou,
+        );
+        if c.flourish_dev > c.potrace_dev {
+            failures.push(format!(
+                "{name}: flourish max deviation {:.3} px > potrace {:.3} px",
+                c.flourish_dev, c.potrace_dev
+            ));
+        }
+        if c.flourish_segments > c.potrace_segments {
+            failures.push(format!(
+                "{name}: flourish {} segments > potrace {}",
+                c.flourish_segments, c.potrace_segments
+            ));
+        }
+        if c.flourish_iou < 0.99 {
+            failures.push(format!(
+                "{name}: flourish IoU with the input bitmap {:.5} < 0.99",
+                c.flourish_iou
+            ));
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "flourish loses to potrace:\n  {}",
+        failures.join("\n  ")
+    );
+}
+
+/// What holds today, guarded against regressions: flourish's curves lie
+/// closer to the true outline than potrace's (the output→truth half of the
+/// Hausdorff distance), and its render matches the input bitmap at least as
+/// well as potrace's.
+#[test]
+fn flourish_is_closer_to_the_outline_than_potrace() {
+    if !support::potrace_available() {
+        let msg =
+            "potrace not found: install it (apt-get install potrace) to compare flourish with it";
+        if std::env::var_os("CI").is_some() {
+            panic!("{msg}");
+        }
+        eprintln!(
+            "\n!!!!!!!! SKIPPED flourish_is_closer_to_the_outline_than_potrace: {msg} !!!!!!!!\n"
+        );
+        return;
+    }
+    for name in BINARY_SAMPLES {
+        let c = compare(name, 1);
+        eprintln!(
+            "{name}: segments {} vs potrace {}; out→truth {:.3} vs {:.3} px; IoU {:.4} vs {:.4}",
+            c.flourish_segments,
+            c.potrace_segments,
+            c.flourish_dev_dir.0,
+            c.potrace_dev_dir.0,
+            c.flourish_iou,
+            c.potrace_iou
+        );
+        assert!(
+            c.flourish_dev_dir.0 <= c.potrace_dev_dir.0,
+            "{name}: flourish strays {:.3} px from the outline, potrace {:.3}",
+            c.flourish_dev_dir.0,
+            c.potrace_dev_dir.0
+        );
+        assert!(
+            c.flourish_iou >= c.potrace_iou,
+            "{name}: IoU {:.4} < potrace {:.4}",
+            c.flourish_iou,
+            c.potrace_iou
+        );
+    }
+}
+
+/// The measuring stick itself: a disc traced by an exact circle has
+/// (nearly) zero deviation, and a shifted one deviates by the shift.
+#[test]
+fn hausdorff_of_known_shapes() {
+    use kurbo::{Circle, Shape};
+    let truth_path = Circle::new((50.0, 50.0), 20.0).to_path(1e-4);
+    let mut truth = Vec::new();
+    flourish::raster::input::flatten_segments(&truth_path, 0.001, &mut truth);
+    let same = Circle::new((50.0, 50.0), 20.0).to_path(1e-4);
+    let d = support::max_deviation(&[same], &truth);
+    assert!(d < 0.02, "{d}");
+    let shifted = Circle::new((50.3, 50.0), 20.0).to_path(1e-4);
+    let d = support::max_deviation(&[shifted], &truth);
+    assert!((d - 0.3).abs() < 0.02, "{d}");
+    let bigger = Circle::new((50.0, 50.0), 21.0).to_path(1e-4);
+    let d = support::max_deviation(&[bigger], &truth);
+    assert!((d - 1.0).abs() < 0.02, "{d}");
+}
+
+/// The ground truth of an even-odd target is all its rings, and potrace's
+/// paths land in pixel coordinates (bounding box of the bitmap's ink).
+#[test]
+fn ground_truth_and_potrace_coordinates() {
+    let svg = support::sample("glyph-a.svg");
+    let truth = support::ground_truth(&svg);
+    assert!(!truth.is_empty());
+    // Every truth point is within the 512 px canvas.
+    for l in &truth {
+        for p in [l.p0, l.p1] {
+            assert!(
+                p.x >= 0.0 && p.x <= 512.0 && p.y >= 0.0 && p.y <= 512.0,
+                "{p:?}"
+            );
+        }
+    }
+    if !support::potrace_available() {
+        eprintln!("!!!!!!!! potrace not found: coordinate check skipped !!!!!!!!");
+        return;
+    }
+    let bitmap = image::open(support::sample("glyph-a-binary.png"))
+        .unwrap()
+        .to_luma8();
+    let (paths, segs, _) = support::run_potrace(&bitmap, 1);
+    assert!(segs > 0);
+    let mut bb = kurbo::Rect::new(f64::MAX, f64::MAX, f64::MIN, f64::MIN);
+    for p in &paths {
+        bb = bb.union(kurbo::Shape::bounding_box(p));
+    }
+    let (mut x0, mut y0, mut x1, mut y1) = (u32::MAX, u32::MAX, 0, 0);
+    for (x, y, p) in bitmap.enumerate_pixels() {
+        if p[0] < 128 {
+            x0 = x0.min(x);
+            y0 = y0.min(y);
+            x1 = x1.max(x + 1);
+            y1 = y1.max(y + 1);
+        }
+    }
+    let ink = kurbo::Rect::new(x0 as f64, y0 as f64, x1 as f64, y1 as f64);
+    for (a, b) in [
+        (bb.x0, ink.x0),
+        (bb.y0, ink.y0),
+        (bb.x1, ink.x1),
+        (bb.y1, ink.y1),
+    ] {
+        assert!(
+            (a - b).abs() < 1.0,
+            "potrace bbox {bb:?} vs ink bbox {ink:?}"
+        );
+    }
+}
