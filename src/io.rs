@@ -89,23 +89,53 @@ pub fn load_svg(path: &Path) -> Result<usvg::Tree> {
 /// Writes `bytes` to `path` atomically: into a temporary file in the same
 /// folder, then renamed over `path`. `-` writes to standard output.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    if path.as_os_str() == "-" {
-        let mut out = std::io::stdout().lock();
-        out.write_all(bytes).map_err(|e| Error::io("<stdout>", e))?;
-        return out.flush().map_err(|e| Error::io("<stdout>", e));
+    write_all_atomic(&[(path, bytes)])
+}
+
+/// Writes several files all or nothing (as far as the file system allows):
+/// every temporary file is written first, and only then are they renamed
+/// into place, so a missing folder or a full disk leaves no output behind.
+/// A path of `-` writes to standard output.
+pub fn write_all_atomic(files: &[(&Path, &[u8])]) -> Result<()> {
+    let mut staged = Vec::new();
+    for &(path, bytes) in files {
+        if path.as_os_str() == "-" {
+            continue;
+        }
+        let dir = match path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d,
+            _ => Path::new("."),
+        };
+        // tempfile's own errors name the temporary file; report the output.
+        let plain = |e: std::io::Error| Error::io(path, std::io::Error::from(e.kind()));
+        let mut tmp = tempfile::Builder::new()
+            .prefix(".flourish-")
+            .suffix(".tmp")
+            .tempfile_in(dir)
+            .map_err(plain)?;
+        tmp.write_all(bytes).map_err(plain)?;
+        tmp.flush().map_err(plain)?;
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            // Temporary files are private (0600); outputs are ordinary files.
+            tmp.as_file()
+                .set_permissions(std::fs::Permissions::from_mode(0o644))
+                .map_err(plain)?;
+        }
+        staged.push((path, tmp));
     }
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".flourish-")
-        .suffix(".tmp")
-        .tempfile_in(dir)
-        .map_err(|e| Error::io(path, e))?;
-    tmp.write_all(bytes).map_err(|e| Error::io(path, e))?;
-    tmp.flush().map_err(|e| Error::io(path, e))?;
-    tmp.persist(path).map_err(|e| Error::io(path, e.error))?;
+    for &(path, bytes) in files {
+        if path.as_os_str() == "-" {
+            let mut out = std::io::stdout().lock();
+            out.write_all(bytes).map_err(|e| Error::io("<stdout>", e))?;
+            out.flush().map_err(|e| Error::io("<stdout>", e))?;
+        }
+    }
+    for (path, tmp) in staged {
+        tmp.persist(path)
+            .map_err(|e| Error::io(path, std::io::Error::from(e.error.kind())))?;
+    }
     Ok(())
 }
 

@@ -256,12 +256,12 @@ fn run_jobs(
             check_not_input(inp, out)?;
             if let Some(p) = preview {
                 check_not_input(inp, p)?;
+                if out.as_os_str() != "-" && io::same_file(out, p) {
+                    return Err(Failure::Usage("--preview and -o name the same file".into()));
+                }
             }
             let svg = job(inp)?;
-            io::write_atomic(out, svg.as_bytes())?;
-            if let Some(p) = preview {
-                render::write_preview(&svg, p)?;
-            }
+            write_outputs(out, &svg, preview)?;
             Ok(())
         }
         (None, Some(dir)) => {
@@ -289,6 +289,9 @@ fn run_jobs(
                     )));
                 }
                 check_not_input(inp, &dir.join(svg_name(inp)))?;
+                if let Some(p) = preview {
+                    check_not_input(inp, &p.join(png_name(inp)))?;
+                }
             }
             let bar = if quiet {
                 ProgressBar::hidden()
@@ -304,15 +307,8 @@ fn run_jobs(
                 .map(|inp| {
                     let r = (|| {
                         let svg = job(inp)?;
-                        io::write_atomic(&dir.join(svg_name(inp)), svg.as_bytes())?;
-                        if let Some(pdir) = preview {
-                            let png = pdir.join(
-                                Path::new(inp.file_stem().unwrap_or_default())
-                                    .with_extension("png"),
-                            );
-                            render::write_preview(&svg, &png)?;
-                        }
-                        Ok(())
+                        let png = preview.map(|pdir| pdir.join(png_name(inp)));
+                        write_outputs(&dir.join(svg_name(inp)), &svg, png.as_deref())
                     })();
                     bar.inc(1);
                     r
@@ -331,6 +327,21 @@ fn run_jobs(
         }
         _ => Err(Failure::Usage("give -o OUT.svg or --out-dir DIR".into())),
     }
+}
+
+/// Writes the SVG and its optional preview, both or neither.
+fn write_outputs(out: &Path, svg: &str, preview: Option<&Path>) -> Result<(), Error> {
+    match preview {
+        Some(p) => {
+            let png = render::preview_png(svg, p)?;
+            io::write_all_atomic(&[(out, svg.as_bytes()), (p, &png)])
+        }
+        None => io::write_atomic(out, svg.as_bytes()),
+    }
+}
+
+fn png_name(inp: &Path) -> PathBuf {
+    Path::new(inp.file_stem().unwrap_or_default()).with_extension("png")
 }
 
 fn svg_name(inp: &Path) -> PathBuf {

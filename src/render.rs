@@ -38,13 +38,19 @@ pub fn render_tree(
 
 /// Renders SVG text on white and writes it as a PNG preview to `out`.
 pub fn write_preview(svg: &str, out: &Path) -> Result<()> {
+    let png = preview_png(svg, out)?;
+    io::write_atomic(out, &png)
+}
+
+/// Renders SVG text on white as PNG bytes (documents smaller than 512 px
+/// are enlarged to 512 px); `out` names the preview in errors.
+pub fn preview_png(svg: &str, out: &Path) -> Result<Vec<u8>> {
     let tree = io::parse_svg(out, svg.as_bytes())?;
     let longest = tree.size().width().max(tree.size().height());
     // Previews of tiny documents are enlarged to a readable size.
     let max_side = if longest < 512.0 { Some(512) } else { None };
     let pixmap = render_tree(out, &tree, max_side, Some([255, 255, 255, 255]))?;
-    let png = pixmap
+    pixmap
         .encode_png()
-        .map_err(|e| Error::invalid(out, format!("PNG encoding failed: {e}")))?;
-    io::write_atomic(out, &png)
+        .map_err(|e| Error::invalid(out, format!("PNG encoding failed: {e}")))
 }

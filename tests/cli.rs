@@ -1,0 +1,1273 @@
+//! End-to-end tests of the `flourish` command line: exit statuses (0
+//! success, 1 failure, 2 usage error), one-line error messages that name the
+//! file, and outputs that are either complete or absent (an existing output
+//! is left untouched when a run fails).
+//!
+//! Every input is generated inside the test (PNGs through `image`, SVGs by
+//! hand) in a temporary folder.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+const BIN: &str = env!("CARGO_BIN_EXE_flourish");
+
+/// Content written to pre-existing outputs: must survive failed runs.
+const SENTINEL: &[u8] = b"do not touch\n";
+
+// ---------------------------------------------------------------------------
+// Helpers
+
+fn flourish(args: &[&str]) -> Output {
+    Command::new(BIN)
+        .args(args)
+        .stdin(Stdio::null())
+        .output()
+        .expect("run flourish")
+}
+
+/// Runs flourish in `dir`, killing it (and failing) after `limit`.
+fn flourish_timed(dir: &Path, args: &[&str], limit: Duration) -> (Output, Duration) {
+    let start = Instant::now();
+    let mut child = Command::new(BIN)
+        .args(args)
+        .current_dir(dir)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run flourish");
+    loop {
+        if child.try_wait().expect("wait").is_some() {
+            break;
+        }
+        if start.elapsed() > limit {
+            let _ = child.kill();
+            let out = child.wait_with_output().expect("collect output");
+            panic!(
+                "flourish {args:?} still running after {limit:?}; stderr: {}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let elapsed = start.elapsed();
+    (child.wait_with_output().expect("collect output"), elapsed)
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().expect("utf-8 temp path")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn code(o: &Output) -> Option<i32> {
+    o.status.code()
+}
+
+/// A run failure: exit 1, exactly one stderr line containing the file name
+/// of `file` and every string of `causes` (case-insensitive).
+#[track_caller]
+fn assert_failure(o: &Output, file: &Path, causes: &[&str]) {
+    let err = stderr(o);
+    assert_eq!(code(o), Some(1), "expected exit 1; stderr: {err}");
+    let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(
+        lines.len(),
+        1,
+        "expected exactly one line on stderr, got: {err:?}"
+    );
+    let name = file.file_name().unwrap().to_str().unwrap();
+    assert!(
+        lines[0].contains(name),
+        "stderr line does not name {name}: {err:?}"
+    );
+    for c in causes {
+        assert!(
+            lines[0].to_lowercase().contains(&c.to_lowercase()),
+            "stderr line does not mention {c:?}: {err:?}"
+        );
+    }
+}
+
+/// A usage error: exit 2 and something on stderr, nothing on stdout.
+#[track_caller]
+fn assert_usage(o: &Output, mention: &str) {
+    let err = stderr(o);
+    assert_eq!(code(o), Some(2), "expected exit 2 (usage); stderr: {err}");
+    assert!(!err.trim().is_empty(), "usage error with an empty stderr");
+    assert!(
+        err.to_lowercase().contains(&mention.to_lowercase()),
+        "usage message does not mention {mention:?}: {err:?}"
+    );
+    assert!(
+        o.stdout.is_empty(),
+        "usage error wrote to stdout: {:?}",
+        stdout(o)
+    );
+}
+
+/// No `.flourish-*.tmp` files left behind in `dir`.
+#[track_caller]
+fn assert_no_temp_files(dir: &Path) {
+    for e in std::fs::read_dir(dir).unwrap() {
+        let name = e.unwrap().file_name().to_string_lossy().into_owned();
+        assert!(
+            !(name.starts_with(".flourish-") && name.ends_with(".tmp")),
+            "temporary file {name} left in {}",
+            dir.display()
+        );
+    }
+}
+
+/// Parses SVG output with the library's own parser and checks its size.
+#[track_caller]
+fn parse_output(svg: &[u8]) -> flourish::Result<resvg::usvg::Tree> {
+    flourish::io::parse_svg(Path::new("output.svg"), svg)
+}
+
+fn tempdir() -> tempfile::TempDir {
+    tempfile::tempdir().expect("temp dir")
+}
+
+// ---------------------------------------------------------------------------
+// Generated inputs
+
+/// Coverage of a disc / ring scene at (x, y), supersampled `ss`×`ss`.
+fn render_gray(w: u32, h: u32, ss: u32, inside: impl Fn(f64, f64) -> bool) -> image::GrayImage {
+    image::GrayImage::from_fn(w, h, |x, y| {
+        let mut n = 0;
+        for j in 0..ss {
+            for i in 0..ss {
+                let px = x as f64 + (i as f64 + 0.5) / ss as f64;
+                let py = y as f64 + (j as f64 + 0.5) / ss as f64;
+                n += inside(px, py) as u32;
+            }
+        }
+        let cov = n as f64 / (ss * ss) as f64;
+        image::Luma([(255.0 * (1.0 - cov)).round() as u8])
+    })
+}
+
+fn disc(cx: f64, cy: f64, r: f64) -> impl Fn(f64, f64) -> bool {
+    move |x, y| (x - cx).powi(2) + (y - cy).powi(2) <= r * r
+}
+
+/// A small black disc on white, `size`×`size`.
+fn write_disc_png(path: &Path, size: u32) {
+    let c = size as f64 / 2.0;
+    render_gray(size, size, 4, disc(c, c, size as f64 * 0.3))
+        .save(path)
+        .expect("write PNG");
+}
+
+/// Several discs and a ring, 200×200, anti-aliased (4×4 supersampling).
+fn write_complex_png(path: &Path) {
+    let discs = [
+        (40.0, 40.0, 25.0),
+        (150.0, 50.0, 30.0),
+        (60.0, 150.0, 18.5),
+        (120.0, 120.0, 12.3),
+    ];
+    let img = render_gray(200, 200, 4, |x, y| {
+        let ring = {
+            let d = ((x - 130.0).powi(2) + (y - 150.0).powi(2)).sqrt();
+            (28.0..=40.0).contains(&d)
+        };
+        ring || discs.iter().any(|&(cx, cy, r)| disc(cx, cy, r)(x, y))
+    });
+    img.save(path).expect("write PNG");
+}
+
+/// A PNG full of noise (so it compresses badly) as bytes.
+fn noisy_png_bytes(w: u32, h: u32) -> Vec<u8> {
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let img = image::RgbImage::from_fn(w, h, |_, _| {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        let b = state.to_le_bytes();
+        image::Rgb([b[0], b[1], b[2]])
+    });
+    let mut out = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut out), image::ImageFormat::Png)
+        .expect("encode PNG");
+    out
+}
+
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut crc = 0xffff_ffffu32;
+    for &b in bytes {
+        crc ^= b as u32;
+        for _ in 0..8 {
+            crc = if crc & 1 != 0 {
+                (crc >> 1) ^ 0xedb8_8320
+            } else {
+                crc >> 1
+            };
+        }
+    }
+    !crc
+}
+
+fn png_chunk(out: &mut Vec<u8>, kind: &[u8; 4], data: &[u8]) {
+    out.extend_from_slice(&(data.len() as u32).to_be_bytes());
+    let mut body = kind.to_vec();
+    body.extend_from_slice(data);
+    out.extend_from_slice(&body);
+    out.extend_from_slice(&crc32(&body).to_be_bytes());
+}
+
+/// A PNG whose header declares `w`×`h` 8-bit greyscale pixels, with a tiny
+/// (valid zlib, far too short) IDAT and an IEND.
+fn png_header_only(w: u32, h: u32) -> Vec<u8> {
+    let mut out = b"\x89PNG\r\n\x1a\n".to_vec();
+    let mut ihdr = Vec::new();
+    ihdr.extend_from_slice(&w.to_be_bytes());
+    ihdr.extend_from_slice(&h.to_be_bytes());
+    ihdr.extend_from_slice(&[8, 0, 0, 0, 0]); // depth 8, grey, deflate, adaptive, no interlace
+    png_chunk(&mut out, b"IHDR", &ihdr);
+    // zlib: header 78 01, one final stored block of 2 bytes (filter 0, pixel 0), Adler-32.
+    let idat = [
+        0x78, 0x01, 0x01, 0x02, 0x00, 0xfd, 0xff, 0x00, 0x00, 0x00, 0x02, 0x00, 0x01,
+    ];
+    png_chunk(&mut out, b"IDAT", &idat);
+    png_chunk(&mut out, b"IEND", &[]);
+    out
+}
+
+const SQUARE_SVG: &str = r#"<svg xmlns="http://www.w3.org/2000/svg" width="100" height="50" viewBox="0 0 100 50">
+<rect x="10" y="10" width="30" height="30" fill="black"/>
+</svg>
+"#;
+
+const SQUARE_SVG_MOVED: &str = r#"<svg xmlns="http://www.w3.org/2000/svg" width="100" height="50" viewBox="0 0 100 50">
+<rect x="50" y="10" width="30" height="30" fill="black"/>
+</svg>
+"#;
+
+const SQUARE_SVG_TALL: &str = r#"<svg xmlns="http://www.w3.org/2000/svg" width="100" height="80" viewBox="0 0 100 80">
+<rect x="10" y="10" width="30" height="30" fill="black"/>
+</svg>
+"#;
+
+// ---------------------------------------------------------------------------
+// trace: bad inputs, one at a time
+
+/// Runs `trace IN -o OUT` twice: once with no output present (it must not
+/// be created) and once with a pre-existing output (it must be untouched).
+/// Returns the first run's output.
+#[track_caller]
+fn trace_must_fail(input: &Path, causes: &[&str]) -> Output {
+    let dir = input.parent().unwrap();
+    let out = dir.join("out.svg");
+    let _ = std::fs::remove_file(&out);
+    let o = flourish(&["trace", s(input), "-o", s(&out)]);
+    assert_failure(&o, input, causes);
+    assert!(!out.exists(), "failed run created {}", out.display());
+    assert_no_temp_files(dir);
+
+    std::fs::write(&out, SENTINEL).unwrap();
+    let o2 = flourish(&["trace", s(input), "-o", s(&out)]);
+    assert_failure(&o2, input, causes);
+    assert_eq!(
+        std::fs::read(&out).unwrap(),
+        SENTINEL,
+        "failed run changed the existing output"
+    );
+    assert_no_temp_files(dir);
+    o
+}
+
+#[test]
+fn random_bytes_are_not_an_image() {
+    let t = tempdir();
+    let p = t.path().join("noise.png");
+    let bytes: Vec<u8> = (0..4096u32)
+        .map(|i| (i.wrapping_mul(2_654_435_761) >> 13) as u8 | 1)
+        .collect();
+    std::fs::write(&p, bytes).unwrap();
+    trace_must_fail(&p, &["image"]);
+}
+
+#[test]
+fn text_file_named_png_is_not_an_image() {
+    let t = tempdir();
+    let p = t.path().join("notes.png");
+    std::fs::write(&p, "This is a shopping list, not a picture.\nmilk\neggs\n").unwrap();
+    trace_must_fail(&p, &["image"]);
+}
+
+#[test]
+fn empty_file_fails_cleanly() {
+    let t = tempdir();
+    let p = t.path().join("empty.png");
+    std::fs::write(&p, b"").unwrap();
+    trace_must_fail(&p, &[]);
+}
+
+#[test]
+fn truncated_png_fails_cleanly() {
+    let t = tempdir();
+    let p = t.path().join("truncated.png");
+    let full = noisy_png_bytes(64, 64);
+    std::fs::write(&p, &full[..full.len() / 2]).unwrap();
+    trace_must_fail(&p, &[]);
+}
+
+#[test]
+fn svg_that_does_not_parse_fails_cleanly() {
+    let t = tempdir();
+    let p = t.path().join("broken.svg");
+    std::fs::write(
+        &p,
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"10\" height=\"10\"><rect x=\"1\" </svg",
+    )
+    .unwrap();
+    trace_must_fail(&p, &["svg"]);
+}
+
+#[test]
+fn svg_with_nonsense_size_fails_cleanly() {
+    let t = tempdir();
+    let p = t.path().join("zero.svg");
+    std::fs::write(&p, r#"<svg xmlns="http://www.w3.org/2000/svg" width="0" height="0"><rect width="1" height="1"/></svg>"#)
+        .unwrap();
+    trace_must_fail(&p, &[]);
+}
+
+#[test]
+fn huge_declared_png_fails_fast_with_size_limit() {
+    let t = tempdir();
+    let p = t.path().join("huge.png");
+    std::fs::write(&p, png_header_only(50_000, 50_000)).unwrap();
+    let out = t.path().join("out.svg");
+    let (o, elapsed) = flourish_timed(
+        t.path(),
+        &["trace", s(&p), "-o", s(&out)],
+        Duration::from_secs(30),
+    );
+    assert_failure(&o, &p, &["size limit"]);
+    assert!(
+        elapsed < Duration::from_secs(5),
+        "took {elapsed:?} to refuse a 50000×50000 header"
+    );
+    assert!(!out.exists());
+    // And the same through the helper (pre-existing output untouched).
+    trace_must_fail(&p, &["size limit"]);
+}
+
+#[test]
+fn huge_declared_svg_canvas_is_capped_by_resolution() {
+    // A huge SVG is rasterized at --resolution, so it is not a size error;
+    // an absurd --resolution is.
+    let t = tempdir();
+    let p = t.path().join("wide.svg");
+    std::fs::write(
+        &p,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="1000000" height="10"><rect width="500000" height="5"/></svg>"#,
+    )
+    .unwrap();
+    let out = t.path().join("out.svg");
+    let (o, elapsed) = flourish_timed(
+        t.path(),
+        &["trace", s(&p), "-o", s(&out), "--resolution", "100000"],
+        Duration::from_secs(30),
+    );
+    assert_failure(&o, &p, &["size limit"]);
+    assert!(elapsed < Duration::from_secs(5), "took {elapsed:?}");
+    assert!(!out.exists());
+}
+
+#[test]
+fn missing_input_fails_cleanly() {
+    let t = tempdir();
+    let p = t.path().join("does-not-exist.png");
+    trace_must_fail(&p, &[]);
+}
+
+#[test]
+fn directory_as_input_fails_cleanly() {
+    let t = tempdir();
+    let p = t.path().join("folder.png");
+    std::fs::create_dir(&p).unwrap();
+    trace_must_fail(&p, &["directory"]);
+}
+
+// ---------------------------------------------------------------------------
+// trace: degenerate but valid inputs
+
+#[test]
+fn all_white_image_gives_valid_empty_svg() {
+    let t = tempdir();
+    let p = t.path().join("white.png");
+    image::GrayImage::from_pixel(40, 30, image::Luma([255]))
+        .save(&p)
+        .unwrap();
+    let out = t.path().join("white.svg");
+    let o = flourish(&["trace", s(&p), "-o", s(&out)]);
+    assert_eq!(code(&o), Some(0), "stderr: {}", stderr(&o));
+    let svg = std::fs::read(&out).unwrap();
+    let text = String::from_utf8(svg.clone()).unwrap();
+    assert!(
+        !text.contains("<path"),
+        "empty image produced paths: {text}"
+    );
+    assert!(text.contains("width=\"40\""), "no width: {text}");
+    assert!(text.contains("height=\"30\""), "no height: {text}");
+    let tree = parse_output(&svg).expect("empty output parses");
+    assert_eq!(tree.size().width(), 40.0);
+    assert_eq!(tree.size().height(), 30.0);
+    assert!(!tree.root().has_children(), "empty output has content");
+}
+
+#[test]
+fn transparent_image_gives_valid_empty_svg() {
+    let t = tempdir();
+    let p = t.path().join("clear.png");
+    image::RgbaImage::from_pixel(16, 16, image::Rgba([0, 0, 0, 0]))
+        .save(&p)
+        .unwrap();
+    let out = t.path().join("clear.svg");
+    let o = flourish(&["trace", s(&p), "-o", s(&out)]);
+    assert_eq!(code(&o), Some(0), "stderr: {}", stderr(&o));
+    let svg = std::fs::read(&out).unwrap();
+    assert!(!String::from_utf8_lossy(&svg).contains("<path"));
+    parse_output(&svg).expect("parses");
+}
+
+#[test]
+fn one_pixel_images_succeed() {
+    let t = tempdir();
+    for (name, v) in [("black1.png", 0u8), ("white1.png", 255), ("grey1.png", 128)] {
+        let p = t.path().join(name);
+        image::GrayImage::from_pixel(1, 1, image::Luma([v]))
+            .save(&p)
+            .unwrap();
+        let out = t.path().join(format!("{name}.svg"));
+        let o = flourish(&["trace", s(&p), "-o", s(&out)]);
+        assert_eq!(code(&o), Some(0), "{name}: stderr: {}", stderr(&o));
+        let svg = std::fs::read(&out).unwrap();
+        let tree =
+            parse_output(&svg).unwrap_or_else(|e| panic!("{name}: output does not parse: {e}"));
+        assert_eq!(tree.size().width(), 1.0, "{name}");
+        assert_eq!(tree.size().height(), 1.0, "{name}");
+    }
+}
+
+#[test]
+fn empty_svg_gives_valid_empty_svg() {
+    let t = tempdir();
+    let p = t.path().join("blank.svg");
+    std::fs::write(
+        &p,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="20" height="10"/>"#,
+    )
+    .unwrap();
+    let out = t.path().join("blank-out.svg");
+    let o = flourish(&["trace", s(&p), "-o", s(&out)]);
+    assert_eq!(code(&o), Some(0), "stderr: {}", stderr(&o));
+    let svg = std::fs::read(&out).unwrap();
+    assert!(!String::from_utf8_lossy(&svg).contains("<path"));
+    let tree = parse_output(&svg).unwrap();
+    assert_eq!((tree.size().width(), tree.size().height()), (20.0, 10.0));
+}
+
+// ---------------------------------------------------------------------------
+// trace: output problems
+
+#[test]
+fn output_in_missing_folder_fails_cleanly() {
+    let t = tempdir();
+    let p = t.path().join("disc.png");
+    write_disc_png(&p, 32);
+    let out = t.path().join("no-such-folder").join("out.svg");
+    let o = flourish(&["trace", s(&p), "-o", s(&out)]);
+    assert_failure(&o, &out, &[]);
+    assert!(!out.exists());
+    assert!(!out.parent().unwrap().exists());
+}
+
+#[test]
+fn output_in_read_only_folder_fails_cleanly() {
+    use std::os::unix::fs::PermissionsExt;
+    let t = tempdir();
+    let p = t.path().join("disc.png");
+    write_disc_png(&p, 32);
+    let ro = t.path().join("ro");
+    std::fs::create_dir(&ro).unwrap();
+    std::fs::write(ro.join("out.svg"), SENTINEL).unwrap();
+    std::fs::set_permissions(&ro, std::fs::Permissions::from_mode(0o555)).unwrap();
+    // As root (or on odd file systems) permissions do not bite: skip.
+    if std::fs::write(ro.join("probe"), b"x").is_ok() {
+        let _ = std::fs::remove_file(ro.join("probe"));
+        std::fs::set_permissions(&ro, std::fs::Permissions::from_mode(0o755)).unwrap();
+        eprintln!("skipped output_in_read_only_folder_fails_cleanly: read-only folder is writable (root?)");
+        return;
+    }
+    let out = ro.join("out.svg");
+    let o = flourish(&["trace", s(&p), "-o", s(&out)]);
+    let new_out = ro.join("new.svg");
+    let o2 = flourish(&["trace", s(&p), "-o", s(&new_out)]);
+    std::fs::set_permissions(&ro, std::fs::Permissions::from_mode(0o755)).unwrap();
+    assert_failure(&o, &out, &[]);
+    assert!(
+        std::fs::read(&out).unwrap() == SENTINEL,
+        "existing output changed"
+    );
+    assert_failure(&o2, &new_out, &[]);
+    assert!(!new_out.exists());
+}
+
+#[test]
+fn output_equal_to_input_is_refused() {
+    let t = tempdir();
+    let p = t.path().join("disc.png");
+    write_disc_png(&p, 32);
+    let before = std::fs::read(&p).unwrap();
+    let o = flourish(&["trace", s(&p), "-o", s(&p)]);
+    assert_ne!(code(&o), Some(0), "overwriting the input was accepted");
+    assert!(
+        matches!(code(&o), Some(1) | Some(2)),
+        "stderr: {}",
+        stderr(&o)
+    );
+    assert_eq!(stderr(&o).lines().count(), 1, "stderr: {}", stderr(&o));
+    assert!(stderr(&o).contains("disc.png"), "stderr: {}", stderr(&o));
+    assert!(std::fs::read(&p).unwrap() == before, "input was changed");
+
+    // Same file under another spelling.
+    let other = format!("{}/./disc.png", s(t.path()));
+    let o = flourish(&["trace", s(&p), "-o", &other]);
+    assert!(
+        matches!(code(&o), Some(1) | Some(2)),
+        "stderr: {}",
+        stderr(&o)
+    );
+    assert!(std::fs::read(&p).unwrap() == before, "input was changed");
+
+    // An SVG input written over itself.
+    let svg = t.path().join("square.svg");
+    std::fs::write(&svg, SQUARE_SVG).unwrap();
+    let o = flourish(&["trace", s(&svg), "-o", s(&svg)]);
+    assert!(
+        matches!(code(&o), Some(1) | Some(2)),
+        "stderr: {}",
+        stderr(&o)
+    );
+    assert_eq!(
+        std::fs::read_to_string(&svg).unwrap(),
+        SQUARE_SVG,
+        "input was changed"
+    );
+}
+
+#[test]
+fn preview_equal_to_input_is_refused() {
+    let t = tempdir();
+    let p = t.path().join("disc.png");
+    write_disc_png(&p, 32);
+    let before = std::fs::read(&p).unwrap();
+    let out = t.path().join("disc.svg");
+    let o = flourish(&["trace", s(&p), "-o", s(&out), "--preview", s(&p)]);
+    assert!(
+        matches!(code(&o), Some(1) | Some(2)),
+        "stderr: {}",
+        stderr(&o)
+    );
+    assert!(std::fs::read(&p).unwrap() == before, "input was changed");
+    assert!(
+        !out.exists(),
+        "output written although the preview was refused"
+    );
+}
+
+#[test]
+fn out_dir_that_would_overwrite_an_input_is_refused() {
+    let t = tempdir();
+    let svg = t.path().join("square.svg");
+    std::fs::write(&svg, SQUARE_SVG).unwrap();
+    let o = flourish(&["trace", s(&svg), "--out-dir", s(t.path())]);
+    assert!(
+        matches!(code(&o), Some(1) | Some(2)),
+        "stderr: {}",
+        stderr(&o)
+    );
+    assert_eq!(
+        std::fs::read_to_string(&svg).unwrap(),
+        SQUARE_SVG,
+        "input was changed"
+    );
+}
+
+#[test]
+fn preview_is_written() {
+    let t = tempdir();
+    let p = t.path().join("disc.png");
+    write_disc_png(&p, 32);
+    let out = t.path().join("disc.svg");
+    let prev = t.path().join("disc-preview.png");
+    let o = flourish(&["trace", s(&p), "-o", s(&out), "--preview", s(&prev)]);
+    assert_eq!(code(&o), Some(0), "stderr: {}", stderr(&o));
+    let img = image::open(&prev).expect("preview is a PNG");
+    assert!(img.width() > 0 && img.height() > 0);
+}
+
+// ---------------------------------------------------------------------------
+// trace: usage errors
+
+#[test]
+fn dash_o_with_two_inputs_is_a_usage_error() {
+    let t = tempdir();
+    let (a, b) = (t.path().join("a.png"), t.path().join("b.png"));
+    write_disc_png(&a, 16);
+    write_disc_png(&b, 16);
+    let out = t.path().join("out.svg");
+    let o = flourish(&["trace", s(&a), s(&b), "-o", s(&out)]);
+    assert_usage(&o, "out-dir");
+    assert!(!out.exists());
+}
+
+#[test]
+fn neither_output_nor_out_dir_is_a_usage_error() {
+    let t = tempdir();
+    let a = t.path().join("a.png");
+    write_disc_png(&a, 16);
+    let o = flourish(&["trace", s(&a)]);
+    assert_usage(&o, "-o");
+}
+
+#[test]
+fn both_output_and_out_dir_is_a_usage_error() {
+    let t = tempdir();
+    let a = t.path().join("a.png");
+    write_disc_png(&a, 16);
+    let out = t.path().join("out.svg");
+    let o = flourish(&["trace", s(&a), "-o", s(&out), "--out-dir", s(t.path())]);
+    assert_usage(&o, "out-dir");
+    assert!(!out.exists());
+}
+
+#[test]
+fn no_inputs_is_a_usage_error() {
+    let o = flourish(&["trace", "-o", "x.svg"]);
+    assert_usage(&o, "IN");
+}
+
+#[test]
+fn bad_tolerance_is_a_usage_error() {
+    let t = tempdir();
+    let a = t.path().join("a.png");
+    write_disc_png(&a, 16);
+    let out = t.path().join("out.svg");
+    for bad in [
+        "--tolerance=0",
+        "--tolerance=-1",
+        "--tolerance=NaN",
+        "--tolerance=inf",
+        "--tolerance=abc",
+        "--tolerance=1e9",
+    ] {
+        let o = flourish(&["trace", s(&a), "-o", s(&out), bad]);
+        assert_usage(&o, "tolerance");
+        assert!(!out.exists(), "{bad}: output written");
+    }
+    // Space-separated forms too.
+    for bad in ["0", "-1", "NaN"] {
+        let o = flourish(&["trace", s(&a), "-o", s(&out), "--tolerance", bad]);
+        assert_eq!(
+            code(&o),
+            Some(2),
+            "--tolerance {bad}: stderr: {}",
+            stderr(&o)
+        );
+        assert!(!out.exists(), "--tolerance {bad}: output written");
+    }
+}
+
+#[test]
+fn bad_min_area_resolution_threads_are_usage_errors() {
+    let t = tempdir();
+    let a = t.path().join("a.png");
+    write_disc_png(&a, 16);
+    let out = t.path().join("out.svg");
+    for (args, mention) in [
+        (vec!["--min-area=-1"], "min-area"),
+        (vec!["--min-area=NaN"], "min-area"),
+        (vec!["--resolution", "0"], "resolution"),
+        (vec!["--resolution=-5"], "resolution"),
+        (vec!["--threads", "0"], "threads"),
+    ] {
+        let mut full = vec!["trace", s(&a), "-o", s(&out)];
+        full.extend(args.iter().copied());
+        let o = flourish(&full);
+        assert_usage(&o, mention);
+        assert!(!out.exists(), "{args:?}: output written");
+    }
+}
+
+#[test]
+fn unknown_flag_is_a_usage_error() {
+    let t = tempdir();
+    let a = t.path().join("a.png");
+    write_disc_png(&a, 16);
+    let out = t.path().join("out.svg");
+    let o = flourish(&["trace", s(&a), "-o", s(&out), "--frobnicate"]);
+    assert_usage(&o, "--frobnicate");
+    assert!(!out.exists());
+    let o = flourish(&["frobnicate"]);
+    assert_usage(&o, "frobnicate");
+    let o = flourish(&[]);
+    assert_eq!(code(&o), Some(2), "no subcommand: stderr {}", stderr(&o));
+}
+
+#[test]
+fn help_and_version_succeed() {
+    let o = flourish(&["--help"]);
+    assert_eq!(code(&o), Some(0));
+    assert!(stdout(&o).contains("trace"));
+    let o = flourish(&["--version"]);
+    assert_eq!(code(&o), Some(0));
+    assert!(stdout(&o).contains("flourish"));
+}
+
+// ---------------------------------------------------------------------------
+// trace: batches
+
+#[test]
+fn out_dir_batch_writes_one_svg_per_input() {
+    let t = tempdir();
+    let outdir = t.path().join("out");
+    std::fs::create_dir(&outdir).unwrap();
+    let inputs: Vec<PathBuf> = (0..3)
+        .map(|i| t.path().join(format!("in{i}.png")))
+        .collect();
+    for (i, p) in inputs.iter().enumerate() {
+        write_disc_png(p, 20 + 8 * i as u32);
+    }
+    let mut args = vec!["trace"];
+    args.extend(inputs.iter().map(|p| s(p)));
+    args.extend(["--out-dir", s(&outdir)]);
+    let o = flourish(&args);
+    assert_eq!(code(&o), Some(0), "stderr: {}", stderr(&o));
+    assert!(
+        stderr(&o).trim().is_empty(),
+        "noise on stderr: {:?}",
+        stderr(&o)
+    );
+    for i in 0..3 {
+        let svg = std::fs::read(outdir.join(format!("in{i}.svg"))).expect("output written");
+        let text = String::from_utf8_lossy(&svg);
+        assert!(text.contains("<path"), "in{i}.svg has no path");
+        let tree = parse_output(&svg).unwrap();
+        assert_eq!(tree.size().width(), (20 + 8 * i) as f32);
+    }
+    assert_eq!(
+        std::fs::read_dir(&outdir).unwrap().count(),
+        3,
+        "unexpected extra files"
+    );
+}
+
+#[test]
+fn out_dir_batch_with_one_bad_input_writes_the_others() {
+    let t = tempdir();
+    let outdir = t.path().join("out");
+    std::fs::create_dir(&outdir).unwrap();
+    let good1 = t.path().join("good1.png");
+    let bad = t.path().join("bad.png");
+    let good2 = t.path().join("good2.png");
+    write_disc_png(&good1, 24);
+    std::fs::write(&bad, b"definitely not a PNG").unwrap();
+    write_disc_png(&good2, 30);
+    // An existing output for the bad input must survive.
+    std::fs::write(outdir.join("bad.svg"), SENTINEL).unwrap();
+    let o = flourish(&[
+        "trace",
+        s(&good1),
+        s(&bad),
+        s(&good2),
+        "--out-dir",
+        s(&outdir),
+    ]);
+    assert_failure(&o, &bad, &[]);
+    assert!(
+        !stderr(&o).contains("good1") && !stderr(&o).contains("good2"),
+        "stderr: {}",
+        stderr(&o)
+    );
+    for name in ["good1.svg", "good2.svg"] {
+        let svg = std::fs::read(outdir.join(name)).unwrap_or_else(|_| panic!("{name} not written"));
+        parse_output(&svg).unwrap();
+    }
+    assert!(
+        std::fs::read(outdir.join("bad.svg")).unwrap() == SENTINEL,
+        "existing output changed"
+    );
+    assert_no_temp_files(&outdir);
+}
+
+#[test]
+fn out_dir_batch_with_missing_input_writes_the_others() {
+    let t = tempdir();
+    let outdir = t.path().join("out");
+    std::fs::create_dir(&outdir).unwrap();
+    let good = t.path().join("good.png");
+    let missing = t.path().join("missing.png");
+    write_disc_png(&good, 24);
+    let o = flourish(&["trace", s(&missing), s(&good), "--out-dir", s(&outdir)]);
+    assert_failure(&o, &missing, &[]);
+    assert!(outdir.join("good.svg").exists());
+    assert!(!outdir.join("missing.svg").exists());
+}
+
+#[test]
+fn out_dir_must_exist() {
+    let t = tempdir();
+    let a = t.path().join("a.png");
+    write_disc_png(&a, 16);
+    let outdir = t.path().join("nowhere");
+    let o = flourish(&["trace", s(&a), "--out-dir", s(&outdir)]);
+    assert_failure(&o, &outdir, &[]);
+    assert!(!outdir.exists());
+}
+
+#[test]
+fn out_dir_with_clashing_names_is_a_usage_error() {
+    let t = tempdir();
+    std::fs::create_dir(t.path().join("x")).unwrap();
+    std::fs::create_dir(t.path().join("out")).unwrap();
+    let a = t.path().join("a.png");
+    let b = t.path().join("x").join("a.png");
+    write_disc_png(&a, 16);
+    write_disc_png(&b, 16);
+    let o = flourish(&["trace", s(&a), s(&b), "--out-dir", s(&t.path().join("out"))]);
+    assert_usage(&o, "a.svg");
+    assert_eq!(std::fs::read_dir(t.path().join("out")).unwrap().count(), 0);
+}
+
+// ---------------------------------------------------------------------------
+// trace: standard output and determinism
+
+#[test]
+fn dash_o_dash_writes_svg_to_stdout() {
+    let t = tempdir();
+    let p = t.path().join("disc.png");
+    write_disc_png(&p, 32);
+    let o = flourish(&["trace", s(&p), "-o", "-"]);
+    assert_eq!(code(&o), Some(0), "stderr: {}", stderr(&o));
+    let text = stdout(&o);
+    assert!(
+        text.trim_start().starts_with("<svg") || text.trim_start().starts_with("<?xml"),
+        "stdout: {text}"
+    );
+    assert!(text.contains("<path"), "stdout: {text}");
+    let tree = parse_output(&o.stdout).expect("stdout parses");
+    assert_eq!(tree.size().width(), 32.0);
+    // Nothing named "-" appears in the working folder.
+    assert!(!Path::new("-").exists());
+
+    // Same bytes as writing to a file.
+    let out = t.path().join("disc.svg");
+    let o2 = flourish(&["trace", s(&p), "-o", s(&out)]);
+    assert_eq!(code(&o2), Some(0));
+    assert!(
+        std::fs::read(&out).unwrap() == o.stdout,
+        "-o - and -o FILE differ"
+    );
+}
+
+#[test]
+fn output_does_not_depend_on_thread_count() {
+    let t = tempdir();
+    let p = t.path().join("scene.png");
+    write_complex_png(&p);
+    let mut outputs = Vec::new();
+    for n in ["1", "2"] {
+        let out = t.path().join(format!("scene-{n}.svg"));
+        let o = flourish(&["trace", s(&p), "-o", s(&out), "--threads", n]);
+        assert_eq!(code(&o), Some(0), "--threads {n}: stderr: {}", stderr(&o));
+        outputs.push(std::fs::read(&out).unwrap());
+    }
+    // Global flag placed before the subcommand.
+    let out = t.path().join("scene-g.svg");
+    let o = flourish(&["--threads", "2", "trace", s(&p), "-o", s(&out)]);
+    assert_eq!(code(&o), Some(0), "stderr: {}", stderr(&o));
+    outputs.push(std::fs::read(&out).unwrap());
+    let text = String::from_utf8_lossy(&outputs[0]);
+    assert!(text.matches("<path").count() >= 1, "no paths: {text}");
+    // Four islands (one disc merges with the ring) and the ring's hole.
+    let subpaths = text.matches(['m', 'M']).count();
+    assert!(subpaths >= 5, "too few subpaths ({subpaths}): {text}");
+    assert!(
+        outputs[0] == outputs[1],
+        "--threads 1 and --threads 2 differ"
+    );
+    assert!(
+        outputs[0] == outputs[2],
+        "--threads placement changes the output"
+    );
+    // And runs are repeatable.
+    let out = t.path().join("scene-again.svg");
+    let o = flourish(&["trace", s(&p), "-o", s(&out), "--threads", "2"]);
+    assert_eq!(code(&o), Some(0));
+    assert!(
+        std::fs::read(&out).unwrap() == outputs[1],
+        "two runs with --threads 2 differ"
+    );
+}
+
+// ---------------------------------------------------------------------------
+// trace: SVG input must not reach outside itself
+
+/// Makes `path` a FIFO when `mkfifo` is available (opening it for reading
+/// would block, so a read shows up as a timeout), else a plain file.
+fn make_trap(path: &Path) -> bool {
+    let ok = Command::new("mkfifo")
+        .arg(path)
+        .status()
+        .map(|s| s.success())
+        .unwrap_or(false);
+    if !ok {
+        std::fs::write(path, SQUARE_SVG).unwrap();
+    }
+    ok
+}
+
+#[test]
+fn svg_external_references_are_not_followed() {
+    let t = tempdir();
+    let dir = t.path();
+    make_trap(&dir.join("pic.png"));
+    make_trap(&dir.join("other.svg"));
+    make_trap(&dir.join("style.css"));
+    let cases = [
+        (
+            "abs-image.svg",
+            r#"<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink" width="50" height="50">
+<image href="/etc/passwd" width="50" height="50"/>
+<image xlink:href="/etc/passwd" width="50" height="50"/>
+<rect x="10" y="10" width="20" height="20"/>
+</svg>"#,
+        ),
+        (
+            "rel-image.svg",
+            r#"<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink" width="50" height="50">
+<image href="pic.png" width="50" height="50"/>
+<image xlink:href="pic.png" width="50" height="50"/>
+<image href="file:pic.png" width="50" height="50"/>
+<rect x="10" y="10" width="20" height="20"/>
+</svg>"#,
+        ),
+        (
+            "use-ext.svg",
+            r#"<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink" width="50" height="50">
+<use href="other.svg#x"/>
+<use xlink:href="other.svg#x"/>
+<rect x="10" y="10" width="20" height="20"/>
+</svg>"#,
+        ),
+        (
+            "css-ext.svg",
+            r#"<?xml-stylesheet href="style.css" type="text/css"?>
+<svg xmlns="http://www.w3.org/2000/svg" width="50" height="50">
+<style>@import url("style.css");</style>
+<rect x="10" y="10" width="20" height="20" style="fill: url(other.svg#g)"/>
+</svg>"#,
+        ),
+        (
+            "entity.svg",
+            r#"<?xml version="1.0"?>
+<!DOCTYPE svg [<!ENTITY ext SYSTEM "other.svg">]>
+<svg xmlns="http://www.w3.org/2000/svg" width="50" height="50">
+<text>&ext;</text>
+<rect x="10" y="10" width="20" height="20"/>
+</svg>"#,
+        ),
+    ];
+    for (name, body) in cases {
+        let p = dir.join(name);
+        std::fs::write(&p, body).unwrap();
+        let out = dir.join(format!("{name}.out.svg"));
+        let (o, _) = flourish_timed(
+            dir,
+            &["trace", s(&p), "-o", s(&out)],
+            Duration::from_secs(30),
+        );
+        let c = code(&o);
+        assert!(
+            matches!(c, Some(0) | Some(1)),
+            "{name}: exit {c:?}, stderr: {}",
+            stderr(&o)
+        );
+        if c == Some(1) {
+            assert_failure(&o, &p, &[]);
+            assert!(!out.exists());
+        } else {
+            let svg = std::fs::read(&out).unwrap();
+            let text = String::from_utf8_lossy(&svg);
+            assert!(
+                !text.contains("root:"),
+                "{name}: /etc/passwd leaked into the output"
+            );
+            assert!(
+                !text.contains("<image"),
+                "{name}: output references an image"
+            );
+            assert!(
+                !text.contains("href"),
+                "{name}: output references another file"
+            );
+            parse_output(&svg).unwrap();
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// diff
+
+fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+#[test]
+fn diff_identical_files_exit_zero() {
+    let t = tempdir();
+    let a = write(t.path(), "a.svg", SQUARE_SVG);
+    let b = write(t.path(), "b.svg", SQUARE_SVG);
+    let o = flourish(&["diff", s(&a), s(&b)]);
+    assert_eq!(code(&o), Some(0), "stderr: {}", stderr(&o));
+    assert!(
+        stdout(&o).starts_with("changed: 0"),
+        "stdout: {}",
+        stdout(&o)
+    );
+    assert!(stderr(&o).is_empty(), "stderr: {}", stderr(&o));
+    // A file against itself.
+    let o = flourish(&["diff", s(&a), s(&a)]);
+    assert_eq!(code(&o), Some(0));
+    // --quiet prints nothing.
+    let o = flourish(&["--quiet", "diff", s(&a), s(&b)]);
+    assert_eq!(code(&o), Some(0));
+    assert!(o.stdout.is_empty(), "stdout: {}", stdout(&o));
+}
+
+#[test]
+fn diff_different_files_exit_one() {
+    let t = tempdir();
+    let a = write(t.path(), "a.svg", SQUARE_SVG);
+    let b = write(t.path(), "b.svg", SQUARE_SVG_MOVED);
+    let o = flourish(&["diff", s(&a), s(&b)]);
+    assert_eq!(code(&o), Some(1), "stderr: {}", stderr(&o));
+    let out = stdout(&o);
+    assert!(out.starts_with("changed: "), "stdout: {out}");
+    assert!(!out.starts_with("changed: 0.000000"), "stdout: {out}");
+    // Within a generous tolerance it passes.
+    let o = flourish(&["diff", s(&a), s(&b), "--tolerance", "0.9"]);
+    assert_eq!(
+        code(&o),
+        Some(0),
+        "stdout: {} stderr: {}",
+        stdout(&o),
+        stderr(&o)
+    );
+}
+
+#[test]
+fn diff_out_writes_three_panels() {
+    let t = tempdir();
+    let a = write(t.path(), "a.svg", SQUARE_SVG);
+    let b = write(t.path(), "b.svg", SQUARE_SVG_MOVED);
+    let d = t.path().join("d.png");
+    let o = flourish(&["diff", s(&a), s(&b), "--out", s(&d)]);
+    assert_eq!(code(&o), Some(1), "stderr: {}", stderr(&o));
+    let img = image::open(&d).expect("diff image is a PNG");
+    // 100×50 rendered with its longest side at DIFF_SIDE px.
+    let side = flourish::diff::DIFF_SIDE;
+    assert_eq!(img.height(), side / 2);
+    assert_eq!(img.width(), 3 * side);
+    assert_eq!(img.width(), 3 * (img.height() * 2));
+    // Identical files also get their panels.
+    let d2 = t.path().join("d2.png");
+    let o = flourish(&["diff", s(&a), s(&a), "--out", s(&d2)]);
+    assert_eq!(code(&o), Some(0));
+    let img = image::open(&d2).unwrap();
+    assert_eq!(img.width(), 3 * side);
+}
+
+#[test]
+fn diff_different_sizes_fail_with_clear_message() {
+    let t = tempdir();
+    let a = write(t.path(), "a.svg", SQUARE_SVG);
+    let b = write(t.path(), "tall.svg", SQUARE_SVG_TALL);
+    let d = t.path().join("d.png");
+    let o = flourish(&["diff", s(&a), s(&b), "--out", s(&d)]);
+    assert_failure(&o, &b, &["size"]);
+    assert!(!d.exists());
+}
+
+#[test]
+fn diff_bad_tolerance_is_a_usage_error() {
+    let t = tempdir();
+    let a = write(t.path(), "a.svg", SQUARE_SVG);
+    for bad in ["2", "NaN", "inf"] {
+        let o = flourish(&["diff", s(&a), s(&a), "--tolerance", bad]);
+        assert_usage(&o, "tolerance");
+    }
+    let o = flourish(&["diff", s(&a), s(&a), "--tolerance=-0.5"]);
+    assert_usage(&o, "tolerance");
+}
+
+#[test]
+fn diff_bad_inputs_fail_cleanly() {
+    let t = tempdir();
+    let a = write(t.path(), "a.svg", SQUARE_SVG);
+    let broken = write(t.path(), "broken.svg", "<svg><g></svg>");
+    let missing = t.path().join("missing.svg");
+    let d = t.path().join("d.png");
+    std::fs::write(&d, SENTINEL).unwrap();
+    for (x, y, bad) in [
+        (&a, &broken, &broken),
+        (&broken, &a, &broken),
+        (&a, &missing, &missing),
+        (&missing, &a, &missing),
+    ] {
+        let o = flourish(&["diff", s(x), s(y), "--out", s(&d)]);
+        assert_failure(&o, bad, &[]);
+        assert_eq!(
+            std::fs::read(&d).unwrap(),
+            SENTINEL,
+            "existing diff image changed"
+        );
+    }
+    // Missing arguments.
+    let o = flourish(&["diff", s(&a)]);
+    assert_eq!(code(&o), Some(2));
+}
+
+#[test]
+fn diff_out_in_missing_folder_fails_cleanly() {
+    let t = tempdir();
+    let a = write(t.path(), "a.svg", SQUARE_SVG);
+    let d = t.path().join("nope").join("d.png");
+    let o = flourish(&["diff", s(&a), s(&a), "--out", s(&d)]);
+    assert_failure(&o, &d, &[]);
+    assert!(!d.exists());
+}
+
+// ---------------------------------------------------------------------------
+// Previews and file modes
+
+#[test]
+fn batch_preview_folder_never_overwrites_an_input() {
+    // `--out-dir out --preview .` with `./a.png` as input would write the
+    // preview of a.png to ./a.png.
+    let t = tempdir();
+    let a = t.path().join("a.png");
+    write_disc_png(&a, 20);
+    let before = std::fs::read(&a).unwrap();
+    let outdir = t.path().join("out");
+    std::fs::create_dir(&outdir).unwrap();
+    let o = flourish(&[
+        "trace",
+        s(&a),
+        "--out-dir",
+        s(&outdir),
+        "--preview",
+        s(t.path()),
+    ]);
+    assert!(
+        std::fs::read(&a).unwrap() == before,
+        "the preview overwrote the input (exit {:?})",
+        code(&o)
+    );
+    assert!(
+        matches!(code(&o), Some(1) | Some(2)),
+        "stderr: {}",
+        stderr(&o)
+    );
+}
+
+#[test]
+fn preview_equal_to_output_is_refused() {
+    let t = tempdir();
+    let a = t.path().join("a.png");
+    write_disc_png(&a, 20);
+    let out = t.path().join("a.svg");
+    let o = flourish(&["trace", s(&a), "-o", s(&out), "--preview", s(&out)]);
+    if code(&o) == Some(0) {
+        let bytes = std::fs::read(&out).unwrap();
+        panic!(
+            "-o X --preview X accepted; X now starts with {:?}",
+            String::from_utf8_lossy(&bytes[..8.min(bytes.len())])
+        );
+    }
+    assert!(
+        matches!(code(&o), Some(1) | Some(2)),
+        "stderr: {}",
+        stderr(&o)
+    );
+}
+
+#[test]
+fn failed_preview_leaves_no_svg_behind() {
+    let t = tempdir();
+    let a = t.path().join("a.png");
+    write_disc_png(&a, 20);
+    let out = t.path().join("a.svg");
+    let prev = t.path().join("no-such-folder").join("a.png");
+    let o = flourish(&["trace", s(&a), "-o", s(&out), "--preview", s(&prev)]);
+    assert_failure(&o, &prev, &[]);
+    assert!(
+        !out.exists(),
+        "the run failed (exit 1) but wrote {}",
+        out.display()
+    );
+}
+
+#[test]
+fn outputs_follow_the_umask() {
+    use std::os::unix::fs::PermissionsExt;
+    let t = tempdir();
+    let a = t.path().join("a.png");
+    write_disc_png(&a, 20);
+    let out = t.path().join("a.svg");
+    let o = Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "umask 022 && exec '{BIN}' trace '{}' -o '{}'",
+            s(&a),
+            s(&out)
+        ))
+        .output()
+        .unwrap();
+    assert_eq!(code(&o), Some(0), "stderr: {}", stderr(&o));
+    let mode = std::fs::metadata(&out).unwrap().permissions().mode() & 0o777;
+    assert_eq!(
+        mode, 0o644,
+        "output mode {mode:o}, expected 644 under umask 022 (temp file mode kept)"
+    );
+}
+
+#[test]
+fn io_errors_name_the_output_not_a_temp_file() {
+    let t = tempdir();
+    let a = t.path().join("a.png");
+    write_disc_png(&a, 20);
+    let out = t.path().join("missing").join("a.svg");
+    let o = flourish(&["trace", s(&a), "-o", s(&out)]);
+    assert_failure(&o, &out, &[]);
+    assert!(
+        !stderr(&o).contains(".flourish-"),
+        "message names the temporary file: {}",
+        stderr(&o)
+    );
+}
