@@ -30,8 +30,8 @@ demo:
 
 # The whole test suite (heavy tests run optimized: see [profile.test]).
 test: deps
-	$(CARGO) test --all-targets
-	$(CARGO) test --doc
+	$(CARGO) build --all-targets
+	$(CARGO) test --tests
 
 # Regenerate the golden files; review the diff before committing.
 golden:

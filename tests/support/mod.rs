@@ -224,16 +224,9 @@ fn keep_pieces(
 // Distances.
 // ---------------------------------------------------------------------------
 
-/// Distance from `p` to segment `l`.
+/// Distance from `p` to segment `l` (the library's own, exact).
 pub fn point_segment_distance(p: Point, l: &Line) -> f64 {
-    let d = l.p1 - l.p0;
-    let len2 = d.hypot2();
-    let t = if len2 > 0.0 {
-        ((p - l.p0).dot(d) / len2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (p - l.p0.lerp(l.p1, t)).hypot()
+    flourish::raster::sdf::point_segment_distance(p, *l)
 }
 
 /// A uniform grid of segments for nearest-distance queries.
