@@ -13,6 +13,7 @@
 
 pub mod diff;
 pub mod error;
+pub mod field;
 pub mod io;
 pub mod pattern;
 pub mod raster;
