@@ -78,6 +78,10 @@ fn flourish_beats_potrace_on_binary_samples() {
     );
 }
 
+/// Both outputs are flattened at 0.01 px before distances are measured, so
+/// deviations closer than this are a tie.
+const MEASUREMENT_RESOLUTION: f64 = 0.01;
+
 /// What holds today, guarded against regressions: flourish's curves lie
 /// closer to the true outline than potrace's (the output→truth half of the
 /// Hausdorff distance), and its render matches the input bitmap at least as
@@ -107,7 +111,7 @@ fn flourish_is_closer_to_the_outline_than_potrace() {
             c.potrace_iou
         );
         assert!(
-            c.flourish_dev_dir.0 <= c.potrace_dev_dir.0,
+            c.flourish_dev_dir.0 <= c.potrace_dev_dir.0 + MEASUREMENT_RESOLUTION,
             "{name}: flourish strays {:.3} px from the outline, potrace {:.3}",
             c.flourish_dev_dir.0,
             c.potrace_dev_dir.0

@@ -31,6 +31,12 @@ use rayon::prelude::*;
 /// exact.
 pub const BAND: f32 = 3.0;
 
+/// The magnitude of an ink sample whose edge passes through its centre
+/// (coverage exactly ½): small enough not to move the outline (contour
+/// vertices are clamped 0.001 px from samples anyway), large enough to keep
+/// the sample on the ink side of `v < 0`.
+pub const MIN_INSIDE: f32 = 1e-3;
+
 /// A signed distance field: one layer of ink as distances (px) at pixel
 /// centres, negative inside, plus the map from pixel coordinates to the
 /// input's user units.
@@ -180,7 +186,9 @@ fn distance_to_segments(inside: &Grid<bool>, segments: &[Line]) -> Grid<f32> {
                 (far2.sqrt() - 0.5).max(BAND)
             };
             if is_in {
-                -mag
+                // A pixel at exactly half coverage has its edge through its
+                // centre; it is still ink, so its value stays negative.
+                -mag.max(MIN_INSIDE)
             } else {
                 mag
             }

@@ -6,7 +6,8 @@
 //! 4-adjacent samples of opposite sign) at the linear interpolation of the
 //! two values, which is exact for a signed distance field near a straight
 //! boundary. Saddle cells are resolved by the value at the cell centre (the
-//! mean of its four corners), the same way in every cell, so the topology is
+//! mean of its four corners; a tie joins the ink, so binary diagonal lines
+//! stay connected), the same way in every cell, so the topology is
 //! consistent. Each crossed link is entered once and left once, so the
 //! segments chain into disjoint closed loops with ink on a fixed side:
 //! outer boundaries have positive signed area, holes negative.
@@ -184,7 +185,10 @@ pub fn extract(values: &Grid<f32>) -> Vec<Contour> {
             let saddle = case == 5 || case == 10;
             let centre_inside = saddle && {
                 let v = |x: i32, y: i32| values.get_or(x as isize, y as isize, 1.0);
-                (v(x, y) + v(x + 1, y) + v(x + 1, y + 1) + v(x, y + 1)) < 0.0
+                // A tie joins the ink: one-pixel diagonal runs in binary
+                // art are lines, not beads (potrace's "minority" policy
+                // for dark-on-light art).
+                (v(x, y) + v(x + 1, y) + v(x + 1, y + 1) + v(x, y + 1)) <= 0.0
             };
             // A segment runs from an edge crossed inside→outside (clockwise)
             // to the out→in edge that bounds the same region of the cell.
@@ -338,28 +342,30 @@ mod tests {
             g.set(x, y, -1.0);
         }
         let cs = extract(&g);
-        // Cell centre between (2,2) and (3,3) averages to 0 → outside: apart.
+        // Cell centre between (2,2) and (3,3) averages to 0, a tie: joined.
+        assert_eq!(cs.len(), 1);
+        cs.iter().for_each(check_clean);
+        // Make the centre outside: apart.
+        g.set(2, 2, -0.5);
+        let cs = extract(&g);
         assert_eq!(cs.len(), 2);
         assert!(cs.iter().all(|c| c.signed_area() > 0.0));
-        // Make the diagonal join: centre inside.
-        g.set(2, 2, -3.0);
-        let cs = extract(&g);
-        assert_eq!(cs.len(), 1);
         cs.iter().for_each(check_clean);
     }
 
     #[test]
     fn checkerboard_of_saddles() {
-        let g = Grid::from_fn(8, 8, |x, y| if (x + y) % 2 == 0 { -1.0f32 } else { 1.0 });
+        let g = Grid::from_fn(8, 8, |x, y| if (x + y) % 2 == 0 { -1.0f32 } else { 1.5 });
         let cs = extract(&g);
-        // Centres average to 0 → outside: every inside sample is its own island.
+        // Centres average to 0.25 → outside: every inside sample is its own island.
         assert_eq!(cs.len(), 32);
         assert!(cs
             .iter()
             .all(|c| c.signed_area() > 0.0 && c.points.len() == 4));
-        let g2 = g.map(|v| if v < 0.0 { -1.5 } else { 1.0 });
+        let g2 = g.map(|v| if v < 0.0 { -1.0 } else { 1.0 });
         let cs2 = extract(&g2);
-        // Centres inside → all inside samples join into one region with holes.
+        // Ties (centres average to exactly 0) join the ink → one region
+        // with holes.
         let outers = cs2.iter().filter(|c| c.signed_area() > 0.0).count();
         assert_eq!(outers, 1);
         assert!(cs2.iter().filter(|c| c.signed_area() < 0.0).count() > 0);

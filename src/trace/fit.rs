@@ -23,6 +23,15 @@ const CORNER_WINDOW: f64 = 1.25;
 /// Turning (radians) above which a vertex is a corner: 55°.
 const CORNER_ANGLE: f64 = 55.0 * std::f64::consts::PI / 180.0;
 
+/// Corners closer than this (px) along the outline are one corner (the
+/// sharper one): less than a pixel, so both corners of a 1-px line's end
+/// survive.
+const CORNER_SEPARATION: f64 = 0.9;
+
+/// Distance (px) from a corner within which tangents come from the polygon
+/// instead of the SDF gradient.
+const CORNER_REACH: f64 = 1.5;
+
 /// One piece of a closed contour between corners (or the whole contour),
 /// parameterized by normalized arc length.
 struct Piece<'a> {
@@ -115,9 +124,17 @@ impl ParamCurveFit for Piece<'_> {
         let travel = self.seg_dir(i);
         let at_start = t <= 0.0;
         let at_end = t >= 1.0;
+        let len = self.length();
+        let near_start = self.corner_start && s < CORNER_REACH;
+        let near_end = self.corner_end && len - s < CORNER_REACH;
         let tangent = if (at_start && self.corner_start) || (at_end && self.corner_end) {
             // At a corner the gradient is undefined: use the side's chord.
             self.chord_dir(s, at_start || sign > 0.0 && !at_end)
+        } else if near_start || near_end {
+            // Near a convex corner the distance field rounds off (its
+            // gradient points at the corner), so the polygon's own
+            // direction is the better tangent there.
+            self.chord_dir(s, near_start)
         } else {
             let g = self.sdf.gradient(p);
             let perp = Vec2::new(-g.y, g.x);
@@ -197,14 +214,14 @@ pub fn corners(pts: &[Point]) -> Vec<usize> {
         // Local maximum within the window (ties broken by index).
         let mut is_max = true;
         let mut j = (i + 1) % n;
-        while j != i && (cum[j] - cum[i]).rem_euclid(total) <= CORNER_WINDOW {
+        while j != i && (cum[j] - cum[i]).rem_euclid(total) < CORNER_SEPARATION {
             if turn[j] > turn[i] {
                 is_max = false;
             }
             j = (j + 1) % n;
         }
         let mut j = (i + n - 1) % n;
-        while j != i && (cum[i] - cum[j]).rem_euclid(total) <= CORNER_WINDOW {
+        while j != i && (cum[i] - cum[j]).rem_euclid(total) < CORNER_SEPARATION {
             if turn[j] >= turn[i] {
                 is_max = false;
             }
@@ -356,13 +373,16 @@ fn split_by_turning<'a>(piece: &Piece<'a>) -> Vec<Piece<'a>> {
 /// beyond the fitting accuracy, for the bilinear interpolation of the SDF.
 pub const CHECK_SLACK: f64 = 0.04;
 
-/// Fits one piece: recursive subdivision of its parameter range with
-/// kurbo's single-cubic fitter (`fit_to_cubic`, which matches area and
-/// moment to the source and measures the error along normals), every cubic
-/// also checked against the SDF itself, then a merging pass that replaces
-/// neighbouring cubics by one wherever one fits. This finds nearly as few
-/// segments as kurbo's global optimizer (`fit_to_bezpath_opt`) at a small
-/// fraction of its cost.
+/// Fits one piece with as few cubics as a greedy cover finds: from the
+/// start of what is left, the longest span that one cubic fits (kurbo's
+/// single-cubic fitter, `fit_to_cubic`, which matches area and moment to the
+/// source and measures the error along normals; every cubic also checked
+/// against the SDF itself) is found by halving until a fit succeeds and then
+/// bisecting between that success and the failure above it. Extending each
+/// span as far as it goes is what an optimal cover does when fitting is
+/// monotone in the span, and it needs no merging pass afterwards. Spans
+/// shorter than [`MIN_SPAN_PX`] that still do not fit fall back to the
+/// polygon, which lies on the level set.
 fn fit_piece(piece: &Piece, accuracy: f64, out: &mut Vec<CubicBez>) {
     let n = piece.pts.len();
     let a = piece.pts[0];
@@ -377,64 +397,103 @@ fn fit_piece(piece: &Piece, accuracy: f64, out: &mut Vec<CubicBez>) {
         out.push(line_cubic(a, b));
         return;
     }
-    let mut spans: Vec<(Range<f64>, CubicBez)> = Vec::new();
-    fit_range(piece, 0.0..1.0, accuracy, 0, &mut spans);
-    // Merge neighbours while a single cubic fits both.
-    let mut merged: Vec<(Range<f64>, CubicBez)> = Vec::with_capacity(spans.len());
-    for (r, c) in spans {
-        if let Some((pr, _)) = merged.last() {
-            let joint = pr.start..r.end;
-            if let Some(m) = fit_checked(piece, joint.clone(), accuracy) {
-                merged.pop();
-                merged.push((joint, m));
-                continue;
+    let total = piece.length();
+    let min_span = (MIN_SPAN_PX / total).min(1.0);
+    let mut start = 0.0;
+    while start < 1.0 {
+        if let Some(c) = fit_span(piece, start..1.0, accuracy) {
+            out.push(c);
+            break;
+        }
+        // Halve until one cubic fits.
+        let mut fail = 1.0;
+        let mut ok: Option<(f64, CubicBez)> = None;
+        let mut end = 0.5 * (start + fail);
+        while end - start >= min_span {
+            if let Some(c) = fit_span(piece, start..end, accuracy) {
+                ok = Some((end, c));
+                break;
+            }
+            fail = end;
+            end = 0.5 * (start + end);
+        }
+        let Some((mut good, mut cubic)) = ok else {
+            // Nothing fits even a short span: the polygon up to there.
+            let end = (start + min_span).min(1.0);
+            polygon(piece, start..end, out);
+            start = end;
+            continue;
+        };
+        // Bisect between the success and the failure above it, down to a
+        // quarter pixel.
+        while (fail - good) * total > 0.25 {
+            let mid = 0.5 * (good + fail);
+            match fit_span(piece, start..mid, accuracy) {
+                Some(c) => {
+                    good = mid;
+                    cubic = c;
+                }
+                None => fail = mid,
             }
         }
-        merged.push((r, c));
+        out.push(cubic);
+        start = good;
     }
-    out.extend(merged.into_iter().map(|(_, c)| c));
+}
+
+/// One cubic for `range`: the fitted one if it passes [`fit_checked`], else
+/// the straight chord if the outline and the level set stay within
+/// [`CHORD_SHARE`] × `accuracy` of it (short
+/// spans of a noisy outline, where the end tangents disagree with the
+/// chord and no cubic passes, are usually this).
+fn fit_span(piece: &Piece, range: Range<f64>, accuracy: f64) -> Option<CubicBez> {
+    fit_checked(piece, range.clone(), accuracy).or_else(|| {
+        let s0 = range.start * piece.length();
+        let s1 = range.end * piece.length();
+        let a = piece.locate(s0).1;
+        let b = piece.locate(s1).1;
+        let chord = kurbo::Line::new(a, b);
+        let within = piece
+            .cum
+            .iter()
+            .zip(&piece.pts)
+            .filter(|(c, _)| **c > s0 && **c < s1)
+            .all(|(_, &p)| {
+                crate::raster::sdf::point_segment_distance(p, chord) <= CHORD_SHARE * accuracy
+            });
+        let on_level_set = || {
+            (1..64).all(|k| {
+                piece.sdf.value(a.lerp(b, k as f64 / 64.0)).abs()
+                    <= CHORD_SHARE * accuracy + CHECK_SLACK
+            })
+        };
+        (a != b && within && on_level_set()).then(|| line_cubic(a, b))
+    })
+}
+
+/// The share of the accuracy a straight chord may use (see [`fit_span`]).
+const CHORD_SHARE: f64 = 0.6;
+
+/// Appends the piece's polygon over `range` as straight cubics.
+fn polygon(piece: &Piece, range: Range<f64>, out: &mut Vec<CubicBez>) {
+    let s0 = range.start * piece.length();
+    let s1 = range.end * piece.length();
+    let mut prev = piece.locate(s0).1;
+    for (i, &c) in piece.cum.iter().enumerate() {
+        if c > s0 && c < s1 {
+            out.push(line_cubic(prev, piece.pts[i]));
+            prev = piece.pts[i];
+        }
+    }
+    let end = piece.locate(s1).1;
+    if end != prev {
+        out.push(line_cubic(prev, end));
+    }
 }
 
 /// Parameter span (of the piece's 0..1) below which a range is not split
 /// further but kept as a polygon.
 const MIN_SPAN_PX: f64 = 1.5;
-
-fn fit_range(
-    piece: &Piece,
-    range: Range<f64>,
-    accuracy: f64,
-    depth: u32,
-    out: &mut Vec<(Range<f64>, CubicBez)>,
-) {
-    if let Some(c) = fit_checked(piece, range.clone(), accuracy) {
-        out.push((range, c));
-        return;
-    }
-    let len = piece.length() * (range.end - range.start);
-    if depth < 24 && len > MIN_SPAN_PX {
-        let mid = 0.5 * (range.start + range.end);
-        fit_range(piece, range.start..mid, accuracy, depth + 1, out);
-        fit_range(piece, mid..range.end, accuracy, depth + 1, out);
-        return;
-    }
-    // Last resort: the polygon itself, which lies on the level set.
-    let s0 = range.start * piece.length();
-    let s1 = range.end * piece.length();
-    let mut prev = piece.locate(s0).1;
-    let mut t_prev = range.start;
-    for (i, &c) in piece.cum.iter().enumerate() {
-        if c > s0 && c < s1 {
-            let t = c / piece.length();
-            out.push((t_prev..t, line_cubic(prev, piece.pts[i])));
-            prev = piece.pts[i];
-            t_prev = t;
-        }
-    }
-    let end = piece.locate(s1).1;
-    if end != prev {
-        out.push((t_prev..range.end, line_cubic(prev, end)));
-    }
-}
 
 /// One cubic for `range` of the piece, if kurbo finds one within `accuracy`
 /// that also stays within `accuracy` + [`CHECK_SLACK`] of the SDF's zero
@@ -447,8 +506,8 @@ fn fit_checked(piece: &Piece, range: Range<f64>, accuracy: f64) -> Option<CubicB
     }
     let (c, _) = kurbo::fit_to_cubic(piece, range, accuracy)?;
     let c = Affine::translate(piece.origin) * c;
-    let ok = (1..32)
-        .all(|k| piece.sdf.value(c.eval(k as f64 / 32.0)).abs() <= accuracy + CHECK_SLACK)
+    let ok = (1..64)
+        .all(|k| piece.sdf.value(c.eval(k as f64 / 64.0)).abs() <= accuracy + CHECK_SLACK)
         && c.arclen(0.01) <= 1.5 * len + 0.5;
     ok.then_some(c)
 }
