@@ -110,8 +110,9 @@ impl Grid<f32> {
     pub fn sample(&self, x: f64, y: f64) -> f32 {
         let fx = (x - 0.5).clamp(0.0, (self.width - 1) as f64);
         let fy = (y - 0.5).clamp(0.0, (self.height - 1) as f64);
-        let x0 = fx.floor() as usize;
-        let y0 = fy.floor() as usize;
+        // Both are clamped to ≥ 0 (NaN becomes 0), so truncation is floor.
+        let x0 = fx as usize;
+        let y0 = fy as usize;
         let x1 = (x0 + 1).min(self.width - 1);
         let y1 = (y0 + 1).min(self.height - 1);
         let tx = (fx - x0 as f64) as f32;

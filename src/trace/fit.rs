@@ -424,9 +424,10 @@ fn fit_piece(piece: &Piece, accuracy: f64, out: &mut Vec<CubicBez>) {
             start = end;
             continue;
         };
-        // Bisect between the success and the failure above it, down to a
-        // quarter pixel.
-        while (fail - good) * total > 0.25 {
+        // Bisect between the success and the failure above it, down to an
+        // eighth of the span found (or half a pixel): a longer search buys
+        // little length and costs a fit per step.
+        while (fail - good) * total > (0.125 * (good - start) * total).max(0.5) {
             let mid = 0.5 * (good + fail);
             match fit_span(piece, start..mid, accuracy) {
                 Some(c) => {
