@@ -145,10 +145,15 @@ fn load_raster(path: &Path, bytes: &[u8], opts: &InputOptions) -> Result<Ink> {
         )
         .expect("sizes match");
         let color = mean_ink_colour(&px, &cov);
-        vec![InkLayer {
-            color,
-            sdf: Sdf::from_coverage(&cov, to_user),
-        }]
+        // A binary bitmap stands for a smooth outline within half a pixel
+        // of its staircase (see `binary`); anti-aliased coverage says where
+        // the edge is.
+        let sdf = if super::binary::is_binary(&cov) {
+            super::binary::sdf(&cov, to_user)
+        } else {
+            Sdf::from_coverage(&cov, to_user)
+        };
+        vec![InkLayer { color, sdf }]
     };
     Ok(Ink {
         width: w as f64,

@@ -2,6 +2,7 @@
 //! signed distance field [`Sdf`] (the seam between every raster mode and the
 //! tracer), and loading of raster and SVG inputs as ink coverage.
 
+pub mod binary;
 pub mod edt;
 pub mod input;
 pub mod sdf;

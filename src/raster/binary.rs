@@ -1,0 +1,476 @@
+//! The outline a binary bitmap stands for: optimal polygons smoothed into
+//! curves, the interpretation potrace made standard (Selinger 2003, §2.2–2.3).
+//!
+//! A binary bitmap only says on which side of each pixel boundary the ink
+//! is; the edge it was rendered from can lie anywhere within half a pixel
+//! of the staircase. Building the SDF from the staircase itself (or from a
+//! lightly smoothed one) makes every later stage follow the jaggies. Here
+//! the staircase is replaced by the simplest curve consistent with it:
+//!
+//! 1. **Paths.** The boundary of the ink as closed loops through the
+//!    midpoints of the pixel edges (marching squares on the ±½ field, ties
+//!    joining the ink as everywhere in flourish).
+//! 2. **Straight runs.** For every vertex `i`, the furthest vertex `j` such
+//!    that the segment `i → j` passes within [`STRAIGHT_TOLERANCE`] of every
+//!    vertex between them and every step advances along it (a cone of
+//!    admissible directions is narrowed vertex by vertex, so this is linear
+//!    in the run length). Runs are anchored at path vertices, which are
+//!    themselves up to half a pixel off the drawn edge, so on shallow
+//!    staircases they are shorter than potrace's unanchored test allows;
+//!    steps 4–5 and the curve fitter downstream make up most of that.
+//! 3. **Optimal polygon.** The fewest such segments around the loop: a
+//!    greedy jump to the furthest straight vertex is optimal from a given
+//!    start, and several starts are tried.
+//! 4. **Vertex adjustment.** Each polygon vertex moves to the intersection
+//!    of the least-squares lines of its two edges' path vertices (their
+//!    interior ones: the ends chamfer the corner), kept within half a pixel
+//!    of where it was.
+//! 5. **Smoothing.** Each vertex becomes either a corner or a cubic from
+//!    the midpoint of its incoming edge to the midpoint of its outgoing
+//!    edge, with control points a fraction `α` of the way to the vertex; `α`
+//!    grows with how far the vertex sticks out of the chord of its
+//!    neighbours, measured in pixel-square units, and a vertex with
+//!    `α ≥` [`ALPHA_MAX`] stays a corner (potrace's `alphamax`).
+//!
+//! The curves are flattened finely; the caller takes the inside of pixel
+//! centres from them (not from the bitmap), so the sign and the distance
+//! of the resulting SDF agree.
+
+use crate::raster::{Coverage, Grid, Sdf};
+use crate::trace::contour;
+use kurbo::{CubicBez, ParamCurve, Point, Vec2};
+use rayon::prelude::*;
+
+/// How far (px) a straight run may pass from the path vertices it replaces.
+/// Half a pixel: the whole uncertainty of a binary edge.
+pub const STRAIGHT_TOLERANCE: f64 = 0.5;
+
+/// Vertices with `α` at least this stay corners (potrace's default 1.0).
+pub const ALPHA_MAX: f64 = 1.0;
+
+/// Flattening tolerance (px) of the smoothed curves.
+const FLATTEN: f64 = 0.02;
+
+/// Longest straight run considered, in path vertices.
+const MAX_RUN: usize = 400;
+
+/// True when every coverage value is exactly 0 or 1.
+pub fn is_binary(cov: &Coverage) -> bool {
+    cov.data().iter().all(|&c| c == 0.0 || c == 1.0)
+}
+
+/// The smoothed outline of binary coverage `cov`: closed polylines in pixel
+/// coordinates (outer loops counter-clockwise in the y-down sense of
+/// [`contour::Contour::signed_area`] > 0, holes the other way).
+pub fn smooth_outline(cov: &Coverage) -> Vec<Vec<Point>> {
+    let values = cov.map(|c| if c >= 0.5 { -0.5 } else { 0.5 });
+    let contours = contour::extract(&values);
+    contours
+        .par_iter()
+        .map(|c| smooth_loop(&c.points))
+        .filter(|p| p.len() >= 3)
+        .collect()
+}
+
+/// Steps 2–5 for one closed path.
+fn smooth_loop(path: &[Point]) -> Vec<Point> {
+    let n = path.len();
+    if n < 4 {
+        return path.to_vec();
+    }
+    let lon = straight_runs(path);
+    let poly = optimal_polygon(&lon, n);
+    if poly.len() < 3 {
+        return path.to_vec();
+    }
+    let vertices = adjust_vertices(path, &poly);
+    smooth_polygon(&vertices)
+}
+
+/// Step 2: `lon[i]` = how many vertices ahead of `i` a straight run from `i`
+/// reaches (at least 1).
+fn straight_runs(path: &[Point]) -> Vec<usize> {
+    let n = path.len();
+    let tol = STRAIGHT_TOLERANCE;
+    (0..n)
+        .into_par_iter()
+        .map(|i| {
+            let p = path[i];
+            // The cone of admissible directions, as its right and left edge
+            // vectors (counter-clockwise from right to left); None = any.
+            let mut cone: Option<(Vec2, Vec2)> = None;
+            let mut farthest: f64 = 0.0;
+            let mut best = 1;
+            for m in 1..n.min(MAX_RUN) {
+                let q = path[(i + m) % n];
+                let d = q - p;
+                let len = d.hypot();
+                // The segment must reach (nearly) as far as every vertex
+                // before it, or it would turn back.
+                if len + tol < farthest {
+                    break;
+                }
+                // Every step must advance along the run: a step across it
+                // (the end cap of a line, a notch) ends the run, or runs
+                // would cut such corners while staying within tolerance of
+                // every vertex.
+                if len > 0.0 {
+                    let step = q - path[(i + m - 1) % n];
+                    if step.dot(d) <= 0.1 * len * step.hypot() {
+                        break;
+                    }
+                }
+                if let Some((r, l)) = cone {
+                    if r.cross(d) < 0.0 || d.cross(l) < 0.0 {
+                        break;
+                    }
+                }
+                best = m;
+                farthest = farthest.max(len);
+                if len > tol {
+                    // The half-angle a of the cone: sin a = tol / len.
+                    let s = tol / len;
+                    let c = (1.0 - s * s).sqrt();
+                    let right = Vec2::new(d.x * c + d.y * s, -d.x * s + d.y * c);
+                    let left = Vec2::new(d.x * c - d.y * s, d.x * s + d.y * c);
+                    cone = Some(match cone {
+                        None => (right, left),
+                        Some((r, l)) => {
+                            let r2 = if r.cross(right) > 0.0 { right } else { r };
+                            let l2 = if left.cross(l) > 0.0 { left } else { l };
+                            if r2.cross(l2) < 0.0 {
+                                // Empty: nothing beyond this vertex.
+                                break;
+                            }
+                            (r2, l2)
+                        }
+                    });
+                }
+            }
+            best
+        })
+        .collect()
+}
+
+/// Step 3: the polygon with fewest straight edges, as path indices in order.
+fn optimal_polygon(lon: &[usize], n: usize) -> Vec<usize> {
+    let cover = |start: usize| -> Vec<usize> {
+        let mut out = vec![start];
+        let mut at = 0usize; // steps from start
+        while at < n {
+            let i = (start + at) % n;
+            let step = lon[i].max(1);
+            at += step;
+            if at >= n {
+                break;
+            }
+            out.push((start + at) % n);
+        }
+        out
+    };
+    let tries = n.min(32);
+    let mut best: Option<Vec<usize>> = None;
+    for k in 0..tries {
+        let start = k * n / tries;
+        let poly = cover(start);
+        if best.as_ref().map_or(true, |b| poly.len() < b.len()) {
+            best = Some(poly);
+        }
+    }
+    best.unwrap_or_default()
+}
+
+/// Step 4: polygon vertices moved to where the least-squares lines of their
+/// two edges meet, within half a pixel of the path vertex.
+fn adjust_vertices(path: &[Point], poly: &[usize]) -> Vec<Point> {
+    let n = path.len();
+    let k = poly.len();
+    // Least-squares line (centroid, unit direction) of each polygon edge's
+    // path vertices, ends included.
+    let lines: Vec<(Point, Vec2)> = (0..k)
+        .map(|e| {
+            let a = poly[e];
+            let b = poly[(e + 1) % k];
+            let count = (b + n - a) % n + 1;
+            // The end vertices are where the path rounds the polygon's
+            // corners (midpoints of pixel edges chamfer every pixel corner
+            // by half a pixel): they belong to neither edge's line.
+            let at = |s: usize| path[(a + s) % n];
+            let chamfer = |end: usize, inner: usize, next: usize| {
+                let d0 = at(inner) - at(end);
+                let d1 = at(next) - at(inner);
+                let diagonal = (d0.x.abs() - 0.5).abs() < 1e-9 && (d0.y.abs() - 0.5).abs() < 1e-9;
+                let axis = (d1.x.abs() - 1.0).abs() < 1e-9 || (d1.y.abs() - 1.0).abs() < 1e-9;
+                count >= 4 && diagonal && axis
+            };
+            let first = usize::from(count >= 4 && chamfer(0, 1, 2));
+            let last = usize::from(count >= 4 && chamfer(count - 1, count - 2, count - 3));
+            let pts = (first..count - last).map(at);
+            fit_line(pts, path[a], path[b])
+        })
+        .collect();
+    (0..k)
+        .map(|e| {
+            let v = path[poly[e]];
+            let (c0, d0) = lines[(e + k - 1) % k];
+            let (c1, d1) = lines[e];
+            let det = d0.cross(d1);
+            let p = if det.abs() < 1e-9 {
+                v
+            } else {
+                let t = (c1 - c0).cross(d1) / det;
+                c0 + d0 * t
+            };
+            Point::new(
+                p.x.clamp(v.x - 0.5, v.x + 0.5),
+                p.y.clamp(v.y - 0.5, v.y + 0.5),
+            )
+        })
+        .collect()
+}
+
+/// Total least squares line through `pts`: centroid and principal direction
+/// (oriented from `a` to `b`).
+fn fit_line(pts: impl Iterator<Item = Point>, a: Point, b: Point) -> (Point, Vec2) {
+    let pts: Vec<Point> = pts.collect();
+    let m = pts.len().max(1) as f64;
+    let c = pts.iter().fold(Vec2::ZERO, |s, p| s + p.to_vec2()) / m;
+    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
+    for p in &pts {
+        let d = p.to_vec2() - c;
+        sxx += d.x * d.x;
+        sxy += d.x * d.y;
+        syy += d.y * d.y;
+    }
+    let angle = 0.5 * (2.0 * sxy).atan2(sxx - syy);
+    let mut d = Vec2::new(angle.cos(), angle.sin());
+    let chord = b - a;
+    if chord.hypot() > 1e-9 && d.dot(chord) < 0.0 {
+        d = -d;
+    }
+    if pts.len() < 2 || !d.x.is_finite() {
+        let l = chord.hypot();
+        d = if l > 1e-9 {
+            chord / l
+        } else {
+            Vec2::new(1.0, 0.0)
+        };
+    }
+    (c.to_point(), d)
+}
+
+/// Step 5: corners and cubics through the edge midpoints, flattened.
+fn smooth_polygon(v: &[Point]) -> Vec<Point> {
+    let k = v.len();
+    let mut out = Vec::new();
+    for j in 0..k {
+        let a = v[(j + k - 1) % k];
+        let p = v[j];
+        let b = v[(j + 1) % k];
+        let m1 = a.midpoint(p);
+        let m2 = p.midpoint(b);
+        let alpha = corner_alpha(a, p, b);
+        if alpha >= ALPHA_MAX {
+            out.push(m1);
+            out.push(p);
+        } else {
+            let alpha = alpha.clamp(0.55, 1.0);
+            let c = CubicBez::new(m1, m1 + (p - m1) * alpha, m2 + (p - m2) * alpha, m2);
+            let steps = cubic_steps(&c);
+            for s in 0..steps {
+                out.push(c.eval(s as f64 / steps as f64));
+            }
+        }
+    }
+    out.dedup_by(|x, y| (*x - *y).hypot() < 1e-9);
+    out
+}
+
+/// Potrace's corner measure: how far the vertex `p` sticks out of the line
+/// through its neighbours `a` and `b`, in units of the pixel square's
+/// extent across that line, mapped so that `α = 4/3 (1 − 1/dd)`.
+fn corner_alpha(a: Point, p: Point, b: Point) -> f64 {
+    let chord = b - a;
+    // The unit-square extent across the chord: |n_x| + |n_y| for the
+    // chord's unit normal, times the chord length (the L∞ normal).
+    let denom = chord.x.abs() + chord.y.abs();
+    if denom < 1e-12 {
+        return ALPHA_MAX;
+    }
+    let dd = ((p - a).cross(chord)).abs() / denom;
+    let alpha = if dd > 1.0 { 1.0 - 1.0 / dd } else { 0.0 };
+    alpha / 0.75
+}
+
+/// Points per cubic for a flattening within [`FLATTEN`] px.
+fn cubic_steps(c: &CubicBez) -> usize {
+    // Second differences bound the deviation of a chord: 1/8 · max |B''| / n².
+    let dd1 = ((c.p2 - c.p1) - (c.p1 - c.p0)).hypot();
+    let dd2 = ((c.p3 - c.p2) - (c.p2 - c.p1)).hypot();
+    let m = 6.0 * dd1.max(dd2);
+    ((m / (8.0 * FLATTEN)).sqrt().ceil() as usize).clamp(1, 64)
+}
+
+/// The SDF of binary coverage read as its smoothed outline: distances to
+/// the curves of [`smooth_outline`], inside taken from the same curves.
+pub fn sdf(cov: &Coverage, to_user: kurbo::Affine) -> Sdf {
+    let loops = smooth_outline(cov);
+    let inside = inside(cov.width(), cov.height(), &loops);
+    let mut segments = Vec::new();
+    for poly in &loops {
+        let n = poly.len();
+        for i in 0..n {
+            segments.push(kurbo::Line::new(poly[i], poly[(i + 1) % n]));
+        }
+    }
+    Sdf::from_segments(&inside, &segments, to_user)
+}
+
+/// Pixel centres inside the closed polylines `loops` (nonzero winding).
+pub fn inside(w: usize, h: usize, loops: &[Vec<Point>]) -> Grid<bool> {
+    let mut rows: Vec<Vec<(f64, i32)>> = vec![Vec::new(); h];
+    for poly in loops {
+        let n = poly.len();
+        for i in 0..n {
+            let (a, b) = (poly[i], poly[(i + 1) % n]);
+            if a.y == b.y {
+                continue;
+            }
+            let (lo, hi) = (a.y.min(b.y), a.y.max(b.y));
+            let r0 = (lo - 0.5).ceil().max(0.0) as usize;
+            let r1 = ((hi - 0.5).ceil().max(0.0) as usize).min(h);
+            let dir = if b.y > a.y { 1 } else { -1 };
+            for (r, row) in rows.iter_mut().enumerate().take(r1).skip(r0) {
+                let y = r as f64 + 0.5;
+                let x = a.x + (y - a.y) / (b.y - a.y) * (b.x - a.x);
+                row.push((x, dir));
+            }
+        }
+    }
+    let mut grid = Grid::new(w, h, false);
+    for (r, row) in rows.iter_mut().enumerate() {
+        row.sort_by(|p, q| p.0.total_cmp(&q.0));
+        let mut wind = 0;
+        for k in 0..row.len().saturating_sub(1) {
+            wind += row[k].1;
+            if wind == 0 {
+                continue;
+            }
+            let x0 = (row[k].0 - 0.5).ceil().max(0.0) as usize;
+            let x1 = ((row[k + 1].0 - 0.5).ceil().max(0.0) as usize).min(w);
+            for x in x0..x1 {
+                grid.set(x, r, true);
+            }
+        }
+    }
+    grid
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn disc(n: usize, cx: f64, cy: f64, r: f64) -> Coverage {
+        Grid::from_fn(n, n, |x, y| {
+            let d = (x as f64 + 0.5 - cx).hypot(y as f64 + 0.5 - cy);
+            if d <= r {
+                1.0
+            } else {
+                0.0
+            }
+        })
+    }
+
+    #[test]
+    fn a_rasterized_disc_becomes_a_round_curve() {
+        let (cx, cy, r) = (40.3, 39.7, 25.0);
+        let loops = smooth_outline(&disc(80, cx, cy, r));
+        assert_eq!(loops.len(), 1);
+        // Within about half a pixel of the true circle everywhere (the
+        // bitmap's own uncertainty, up to √2/2 along diagonals), and far
+        // closer on average.
+        let dev: Vec<f64> = loops[0]
+            .iter()
+            .map(|p| ((p.x - cx).hypot(p.y - cy) - r).abs())
+            .collect();
+        let max = dev.iter().cloned().fold(0.0, f64::max);
+        let mean = dev.iter().sum::<f64>() / dev.len() as f64;
+        assert!(max < 0.6, "max {max}");
+        assert!(mean < 0.2, "mean {mean}");
+    }
+
+    #[test]
+    fn a_square_keeps_its_corners() {
+        let cov = Grid::from_fn(40, 40, |x, y| {
+            if (10..30).contains(&x) && (10..30).contains(&y) {
+                1.0
+            } else {
+                0.0
+            }
+        });
+        let loops = smooth_outline(&cov);
+        assert_eq!(loops.len(), 1);
+        // The four corners (10,10) … (30,30) are on the outline.
+        for c in [(10.0, 10.0), (30.0, 10.0), (30.0, 30.0), (10.0, 30.0)] {
+            let c = Point::new(c.0, c.1);
+            let d = loops[0]
+                .iter()
+                .map(|p| (*p - c).hypot())
+                .fold(f64::INFINITY, f64::min);
+            assert!(d < 0.75, "corner {c:?} missed by {d}");
+        }
+        // Inside test: the pixel centres of the square, and only them.
+        let ins = inside(40, 40, &loops);
+        for y in 0..40 {
+            for x in 0..40 {
+                assert_eq!(ins.get(x, y), cov.get(x, y) == 1.0, "{x},{y}");
+            }
+        }
+    }
+
+    #[test]
+    fn straight_runs_follow_a_shallow_staircase() {
+        // A band of slope 1/5 rasterized: its long edges are staircases of
+        // five-pixel steps. Runs are anchored at a vertex that may itself be
+        // half a pixel off the drawn edge, so they span a couple of steps,
+        // not the whole edge (see the module docs).
+        let cov = Grid::from_fn(90, 40, |x, y| {
+            let (x, y) = (x as f64 + 0.5, y as f64 + 0.5);
+            let c = 10.3 + x / 5.0;
+            if (y - c).abs() < 4.0 && (5.0..85.0).contains(&x) {
+                1.0
+            } else {
+                0.0
+            }
+        });
+        let values = cov.map(|c| if c >= 0.5 { -0.5 } else { 0.5 });
+        let cs = contour::extract(&values);
+        assert_eq!(cs.len(), 1);
+        let path = &cs[0].points;
+        let n = path.len();
+        let lon = straight_runs(path);
+        let longest = lon.iter().copied().max().unwrap_or(0);
+        assert!(longest >= 8, "longest run {longest} of {n}");
+        // Straight means: every vertex within the tolerance of the chord.
+        for (i, &m) in lon.iter().enumerate() {
+            let chord = kurbo::Line::new(path[i], path[(i + m) % n]);
+            for k in 0..=m {
+                let d = crate::raster::sdf::point_segment_distance(path[(i + k) % n], chord);
+                assert!(d <= STRAIGHT_TOLERANCE + 1e-9, "run {i}+{m}: {d}");
+            }
+        }
+        // The polygon needs far fewer vertices than the path.
+        let poly = optimal_polygon(&lon, n);
+        assert!(poly.len() * 5 <= n, "{} vertices of {n}", poly.len());
+        // And the smoothed outline stays within half a pixel (plus the
+        // rounding of the band's four corners) of the drawn band's edges.
+        let loops = smooth_outline(&cov);
+        assert_eq!(loops.len(), 1);
+        for p in &loops[0] {
+            if (6.0..84.0).contains(&p.x) {
+                let off = ((p.y - 10.3 - p.x / 5.0).abs() - 4.0).abs();
+                assert!(off < 0.6, "{p:?} is {off} px off the band's edge");
+            }
+        }
+    }
+}
