@@ -15,7 +15,7 @@
 //! - [`baseline`]: the "art brush" reference, one exemplar stretched along
 //!   the whole query.
 
-// pub mod arap;
+pub mod arap;
 // pub mod baseline;
 // pub mod graphcut;
 pub mod matching;
