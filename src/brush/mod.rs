@@ -17,6 +17,6 @@
 
 pub mod arap;
 // pub mod baseline;
-// pub mod graphcut;
+pub mod graphcut;
 pub mod matching;
 pub mod query;
