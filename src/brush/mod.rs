@@ -16,7 +16,7 @@
 //!   the whole query.
 
 pub mod arap;
-// pub mod baseline;
+pub mod baseline;
 pub mod graphcut;
 pub mod matching;
 pub mod query;
