@@ -1,7 +1,7 @@
 //! Criterion benchmarks of the brush stages (decobrush.txt §5.1–5.3):
 //! piecewise matching of a 200-sample query against 10 exemplars of 100
 //! samples, ARAP factorization and solve on a 60-rib mesh, and the
-//! graph-cut seam on a 256×64 overlap. Setup is kept out of the timings.
+//! graph-cut seam on 256×64 and 300×100 overlaps. Setup is kept out of the timings.
 //! Run with `make bench` or
 //! `cargo bench --bench brush -- --warm-up-time 1 --measurement-time 3`.
 
@@ -76,7 +76,6 @@ fn bench_arap(c: &mut Criterion) {
 }
 
 fn bench_graphcut(c: &mut Criterion) {
-    let (w, h) = (256, 64);
     // Two ornaments of curved ink lines, slightly out of phase.
     let ink = |x: usize, y: usize, phase: f64| {
         let v = ((x as f64 * 0.21 + phase).sin() * 6.0 + y as f64 * 0.9).sin();
@@ -86,19 +85,21 @@ fn bench_graphcut(c: &mut Criterion) {
             1.0
         }
     };
-    let a = Grid::from_fn(w, h, |x, y| ink(x, y, 0.0));
-    let b = Grid::from_fn(w, h, |x, y| ink(x, y, 0.4));
-    let cover = Grid::from_fn(w, h, |x, _| match x {
-        0..=15 => Cover::A,
-        240.. => Cover::B,
-        _ => Cover::Both,
-    });
     let params = SeamParams::default();
     let mut g = c.benchmark_group("brush");
     g.sample_size(10);
-    g.bench_function("graphcut/256x64", |bch| {
-        bch.iter(|| black_box(seam(&a, &b, &cover, &params).expect("cuts")))
-    });
+    for (w, h) in [(256, 64), (300, 100)] {
+        let a = Grid::from_fn(w, h, |x, y| ink(x, y, 0.0));
+        let b = Grid::from_fn(w, h, |x, y| ink(x, y, 0.4));
+        let cover = Grid::from_fn(w, h, |x, _| match x {
+            x if x < 16 => Cover::A,
+            x if x >= w - 16 => Cover::B,
+            _ => Cover::Both,
+        });
+        g.bench_function(format!("graphcut/{w}x{h}"), |bch| {
+            bch.iter(|| black_box(seam(&a, &b, &cover, &params).expect("cuts")))
+        });
+    }
     g.finish();
 }
 

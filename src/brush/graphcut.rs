@@ -12,15 +12,15 @@
 //! infinite terminal links.
 //!
 //! The least-cost labeling is an s–t minimum cut (A = source side), found
-//! exactly with Dinic's max-flow on integer capacities (costs quantized to
-//! 10⁻⁶, so the cut value and the brute-force minimum agree exactly; tested
-//! on every labeling of tiny grids). The paper uses Schmidt et al.'s planar
-//! cut; on grids of a few 10⁴ pixels Dinic takes milliseconds (see the
-//! brush benchmark).
+//! exactly with Boykov–Kolmogorov max-flow ([`crate::brush::maxflow`]) on
+//! integer capacities (costs quantized to 10⁻⁶, so the cut value and the
+//! brute-force minimum agree exactly; tested on every labeling of tiny
+//! grids). The paper uses Schmidt et al.'s planar cut; any exact minimum
+//! cut gives the same cost.
 
+use crate::brush::maxflow::FlowGraph;
 use crate::error::{Error, Result};
 use crate::raster::Grid;
-use std::collections::VecDeque;
 
 /// Which segments cover an overlap-grid pixel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -166,128 +166,6 @@ pub fn seam(
         labels,
         cost: flow as f64 / SCALE,
     })
-}
-
-/// A directed flow network with integer capacities; edges are stored in
-/// pairs (`e`, `e ^ 1`) so each one's residual reverse is at hand.
-pub struct FlowGraph {
-    head: Vec<usize>,
-    next: Vec<usize>,
-    to: Vec<usize>,
-    cap: Vec<i64>,
-}
-
-const NIL: usize = usize::MAX;
-
-impl FlowGraph {
-    /// An empty network of `n` nodes.
-    pub fn new(n: usize) -> Self {
-        FlowGraph {
-            head: vec![NIL; n],
-            next: Vec::new(),
-            to: Vec::new(),
-            cap: Vec::new(),
-        }
-    }
-
-    /// Adds the link `u → v` with capacity `uv` and `v → u` with `vu`
-    /// (negative capacities count as 0; out-of-range nodes are ignored).
-    pub fn add_edge(&mut self, u: usize, v: usize, uv: i64, vu: i64) {
-        if u >= self.head.len() || v >= self.head.len() {
-            return;
-        }
-        for (from, to, c) in [(u, v, uv), (v, u, vu)] {
-            self.to.push(to);
-            self.cap.push(c.max(0));
-            self.next.push(self.head[from]);
-            self.head[from] = self.to.len() - 1;
-        }
-    }
-
-    /// Breadth-first levels from `s` over edges with residual capacity.
-    fn levels(&self, s: usize) -> Vec<u32> {
-        let mut level = vec![u32::MAX; self.head.len()];
-        let mut queue = VecDeque::new();
-        level[s] = 0;
-        queue.push_back(s);
-        while let Some(u) = queue.pop_front() {
-            let mut e = self.head[u];
-            while e != NIL {
-                let v = self.to[e];
-                if self.cap[e] > 0 && level[v] == u32::MAX {
-                    level[v] = level[u] + 1;
-                    queue.push_back(v);
-                }
-                e = self.next[e];
-            }
-        }
-        level
-    }
-
-    /// The maximum flow from `s` to `t` (Dinic: BFS level graph, then
-    /// blocking flows by iterative depth-first search with current-arc
-    /// pointers). Leaves the residual network for [`FlowGraph::source_side`].
-    pub fn max_flow(&mut self, s: usize, t: usize) -> i64 {
-        let n = self.head.len();
-        if s >= n || t >= n || s == t {
-            return 0;
-        }
-        let mut total: i64 = 0;
-        loop {
-            let mut level = self.levels(s);
-            if level[t] == u32::MAX {
-                return total;
-            }
-            let mut arc = self.head.clone();
-            let mut path: Vec<usize> = Vec::new();
-            let mut u = s;
-            loop {
-                if u == t {
-                    // Augment along the path by its bottleneck.
-                    let push = path.iter().map(|&e| self.cap[e]).min().unwrap_or(0);
-                    for &e in &path {
-                        self.cap[e] -= push;
-                        self.cap[e ^ 1] += push;
-                    }
-                    total = total.saturating_add(push);
-                    // Restart from the tail of the first saturated edge.
-                    let cut = path.iter().position(|&e| self.cap[e] == 0).unwrap_or(0);
-                    path.truncate(cut);
-                    u = path.last().map_or(s, |&e| self.to[e]);
-                    continue;
-                }
-                // Advance along an admissible arc, or retreat.
-                let mut e = arc[u];
-                while e != NIL {
-                    let v = self.to[e];
-                    if self.cap[e] > 0 && level[v] == level[u] + 1 {
-                        break;
-                    }
-                    e = self.next[e];
-                }
-                arc[u] = e;
-                if e != NIL {
-                    path.push(e);
-                    u = self.to[e];
-                    continue;
-                }
-                level[u] = u32::MAX; // dead end for this phase
-                match path.pop() {
-                    None => break,
-                    Some(back) => {
-                        u = self.to[back ^ 1];
-                        arc[u] = self.next[arc[u]];
-                    }
-                }
-            }
-        }
-    }
-
-    /// After [`FlowGraph::max_flow`]: which nodes the source still reaches
-    /// in the residual network (the source side of a minimum cut).
-    pub fn source_side(&self, s: usize) -> Vec<bool> {
-        self.levels(s).iter().map(|&l| l != u32::MAX).collect()
-    }
 }
 
 #[cfg(test)]

@@ -19,4 +19,5 @@ pub mod arap;
 pub mod baseline;
 pub mod graphcut;
 pub mod matching;
+pub mod maxflow;
 pub mod query;
