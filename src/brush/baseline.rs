@@ -91,6 +91,10 @@ pub fn art_brush_positions(
     if spine.len() < 2 || spine.len() != mesh.spine.len() {
         return bad("the exemplar mesh has fewer than two ribs");
     }
+    let per = mesh.per_rib;
+    if per == 0 || mesh.rest.len() != per * spine.len() {
+        return bad("the mesh is not a rib mesh (vertex count ≠ ribs × per_rib)");
+    }
     if query.len() < 2 || !query.iter().all(|p| p.x.is_finite() && p.y.is_finite()) {
         return bad("the query needs at least two finite points");
     }
@@ -104,7 +108,6 @@ pub fn art_brush_positions(
         return bad("a spine has zero length");
     }
     // Exemplar width: mean outline-to-outline rib length.
-    let per = mesh.per_rib;
     let we = (0..spine.len())
         .filter_map(|i| {
             Some(

@@ -466,6 +466,21 @@ mod tests {
     }
 
     #[test]
+    fn degenerate_subpaths_are_skipped_and_the_rest_kept() {
+        let s = sketch(
+            r##"<path id="multi" d="M10 20 L60 20 M90 90 L90 90 M100 100 Z M120 120 L150 150" stroke="#000" stroke-width="4" fill="none"/>"##,
+        );
+        let set = spines(&s, &QueryOptions::default()).unwrap();
+        let ids: Vec<usize> = set.spines.iter().map(|s| s.subpath).collect();
+        assert_eq!(set.spines.len(), 2, "{ids:?} {:?}", set.warnings);
+        assert!(!set.warnings.is_empty());
+        assert!(set
+            .warnings
+            .iter()
+            .all(|w| w.starts_with("s.svg: query multi subpath")));
+    }
+
+    #[test]
     fn zero_length_and_single_point_polylines_are_degenerate() {
         let p = Point::new(3.0, 4.0);
         assert_eq!(
