@@ -95,19 +95,8 @@ impl Exemplar {
     }
 
     fn features(&self) -> SpineFeatures {
-        let len = query::polyline_length(&self.spine);
-        let samples = query::features(&self.spine, 2.0 * HALF, len);
-        let mut f = SpineFeatures::from_query(&QuerySpine {
-            query_id: String::new(),
-            subpath: 0,
-            style: None,
-            width: 2.0 * HALF,
-            spacing: SPACING,
-            length: len,
-            samples,
-        });
         // Appearance: mean ink across each rib.
-        f.appearance = (0..self.spine.len())
+        let appearance = (0..self.spine.len())
             .map(|i| {
                 let ink: f32 = (0..=10)
                     .map(|k| self.ink(self.right[i].lerp(self.left[i], k as f64 / 10.0)))
@@ -115,7 +104,7 @@ impl Exemplar {
                 vec![ink as f64 / 11.0]
             })
             .collect();
-        f
+        SpineFeatures::from_ribs(&self.spine, &self.left, &self.right, appearance).expect("ribs")
     }
 }
 

@@ -29,6 +29,7 @@
 use crate::brush::query::QuerySpine;
 use crate::error::{Error, Result};
 use crate::pattern::rng;
+use kurbo::Point;
 use std::collections::HashMap;
 use std::ops::Range;
 
@@ -59,6 +60,47 @@ pub struct SpineFeatures {
 }
 
 impl SpineFeatures {
+    /// The features of an exemplar given by its ribs (spine, left and right
+    /// outline points per sample, equally spaced along the spine, in the
+    /// common length unit): turning angles and end distances from the
+    /// spine, width from the rib length `|left − right|`, and the given
+    /// appearance descriptors (one per rib, or none).
+    pub fn from_ribs(
+        spine: &[Point],
+        left: &[Point],
+        right: &[Point],
+        appearance: Vec<Vec<f64>>,
+    ) -> Result<Self> {
+        let n = spine.len();
+        if n < 2 || left.len() != n || right.len() != n {
+            return Err(Error::degenerate(
+                "exemplar features",
+                "needs at least two ribs with spine, left and right points",
+            ));
+        }
+        if !appearance.is_empty() && appearance.len() != n {
+            return Err(Error::degenerate(
+                "exemplar features",
+                format!("{} appearance descriptors for {n} ribs", appearance.len()),
+            ));
+        }
+        let length = crate::brush::query::polyline_length(spine);
+        let samples = crate::brush::query::features(spine, 0.0, length)
+            .iter()
+            .zip(left.iter().zip(right))
+            .map(|(q, (l, r))| SampleFeature {
+                turning: q.turning,
+                width: l.distance(*r),
+                dist_start: q.dist_start,
+                dist_end: q.dist_end,
+            })
+            .collect();
+        Ok(SpineFeatures {
+            samples,
+            appearance,
+        })
+    }
+
     /// The features of a query spine (no appearance descriptors).
     pub fn from_query(q: &QuerySpine) -> Self {
         SpineFeatures {

@@ -1,6 +1,7 @@
 //! Tests of the piecewise matching: the DP against exhaustive enumeration.
 
 use super::*;
+use kurbo::Point;
 use proptest::prelude::*;
 
 fn straight(n: usize, width: f64, turning: f64) -> SpineFeatures {
@@ -234,4 +235,29 @@ fn bad_inputs_are_errors() {
         ..MatchOptions::default()
     };
     assert!(match_query(&q, &[straight(3, 1.0, 0.0)], &opts).is_err());
+}
+
+#[test]
+fn rib_features_measure_turning_width_and_ends() {
+    // A quarter circle of radius 20, 11 ribs, half-widths 3 (left) and 2.
+    let r = 20.0;
+    let pt = |a: f64, d: f64| Point::new((r - d) * a.sin(), r - (r - d) * a.cos());
+    let angles: Vec<f64> = (0..11)
+        .map(|i| i as f64 * std::f64::consts::FRAC_PI_2 / 10.0)
+        .collect();
+    let spine: Vec<Point> = angles.iter().map(|&a| pt(a, 0.0)).collect();
+    let left: Vec<Point> = angles.iter().map(|&a| pt(a, 3.0)).collect();
+    let right: Vec<Point> = angles.iter().map(|&a| pt(a, -2.0)).collect();
+    let f = SpineFeatures::from_ribs(&spine, &left, &right, vec![]).unwrap();
+    let step = std::f64::consts::FRAC_PI_2 / 10.0;
+    for (i, s) in f.samples.iter().enumerate() {
+        assert!((s.width - 5.0).abs() < 1e-9);
+        if i > 0 && i < 10 {
+            assert!((s.turning - step).abs() < 1e-9, "{}", s.turning);
+        }
+    }
+    assert_eq!(f.samples[0].dist_start, 0.0);
+    assert!((f.samples[10].dist_start - f.samples[0].dist_end).abs() < 1e-9);
+    assert!(SpineFeatures::from_ribs(&spine, &left[1..], &right, vec![]).is_err());
+    assert!(SpineFeatures::from_ribs(&spine, &left, &right, vec![vec![1.0]]).is_err());
 }
