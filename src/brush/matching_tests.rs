@@ -30,7 +30,8 @@ fn exhaustive(p: &Problem, q0: usize, last: Option<(usize, usize)>) -> f64 {
     }
     let lens = p.exemplar_lens();
     let mut best = f64::INFINITY;
-    for len in p.min_segment()..=n - q0 {
+    let longest = p.max_segment().unwrap_or(n).min(n - q0);
+    for len in p.min_segment()..=longest {
         for (e, &le) in lens.iter().enumerate() {
             for s0 in 0..le {
                 if s0 + len > le {
@@ -93,11 +94,13 @@ proptest! {
         query in features(6),
         exemplars in proptest::collection::vec(features(5), 1..=3),
         min_segment in 1usize..=3,
+        max_segment in proptest::option::of(1usize..=4),
         seed in 0u64..4,
     ) {
         let opts = MatchOptions {
             candidates: usize::MAX,
             min_segment,
+            max_segment,
             end_zone: 0.3,
             end_horizon: 1.0,
             seed,
@@ -115,6 +118,7 @@ proptest! {
                 for s in &m.segments {
                     prop_assert_eq!(s.core.start, q);
                     prop_assert!(s.core.len() >= p.min_segment());
+                    prop_assert!(s.core.len() <= p.max_segment().unwrap_or(usize::MAX));
                     prop_assert_eq!(s.query.len(), s.exemplar_samples.len());
                     prop_assert!(s.exemplar_samples.end <= exemplars[s.exemplar].samples.len());
                     q = s.core.end;
@@ -260,4 +264,17 @@ fn rib_features_measure_turning_width_and_ends() {
     assert!((f.samples[10].dist_start - f.samples[0].dist_end).abs() < 1e-9);
     assert!(SpineFeatures::from_ribs(&spine, &left[1..], &right, vec![]).is_err());
     assert!(SpineFeatures::from_ribs(&spine, &left, &right, vec![vec![1.0]]).is_err());
+}
+
+#[test]
+fn max_segment_splits_long_runs() {
+    let q = straight(40, 1.0, 0.0);
+    let ex = [straight(60, 1.0, 0.0)];
+    let opts = MatchOptions {
+        max_segment: Some(12),
+        ..MatchOptions::default()
+    };
+    let m = match_query(&q, &ex, &opts).unwrap();
+    assert!(m.segments.len() >= 4, "{:?}", m.segments);
+    assert!(m.segments.iter().all(|s| s.core.len() <= 12));
 }
