@@ -451,10 +451,14 @@ pub fn match_query(
                 .collect()
         });
         // Offers a value for slot (c, r); near-ties go to the lower hash.
+        // The hashes are computed only for near-ties.
         let mut offer = |slot: usize, v: f64, b: Back| {
-            let key = back_key(opts.seed, q, slot, b);
-            let cur_key = back_key(opts.seed, q, slot, back[slot]);
-            if v.is_finite() && near_better(v, key, cost[slot], cur_key) {
+            let cur = cost[slot];
+            let better = !cur.is_finite()
+                || v < cur - tol(cur)
+                || (v <= cur + tol(cur)
+                    && back_key(opts.seed, q, slot, b) < back_key(opts.seed, q, slot, back[slot]));
+            if v.is_finite() && better {
                 cost[slot] = v;
                 back[slot] = b;
             }
