@@ -191,20 +191,16 @@ fn path_is_finite(path: &BezPath) -> bool {
     })
 }
 
+/// Whether the polyline's bounding box meets `view` (edges included).
 fn touches(poly: &[Point], view: Rect) -> bool {
     let Some(first) = poly.first() else {
         return true; // empty subpaths are reported as degenerate instead
     };
-    let bbox = poly
+    let r = poly
         .iter()
         .fold(Rect::from_points(*first, *first), |r, p| r.union_pt(*p));
-    bbox.intersect(view).area() > 0.0
-        || view.contains(*first)
-        || bbox.area() == 0.0 && {
-            // A horizontal or vertical segment has a zero-area box.
-            let r = bbox;
-            r.x1 >= view.x0 && r.x0 <= view.x1 && r.y1 >= view.y0 && r.y0 <= view.y1
-        }
+    // Closed intervals, so lines along an edge of the view still count.
+    r.x1 >= view.x0 && r.x0 <= view.x1 && r.y1 >= view.y0 && r.y0 <= view.y1
 }
 
 /// Flattens every subpath of `path` into a polyline (closed subpaths end on
