@@ -328,41 +328,11 @@ pub fn sdf(cov: &Coverage, to_user: kurbo::Affine) -> Sdf {
 
 /// Pixel centres inside the closed polylines `loops` (nonzero winding).
 pub fn inside(w: usize, h: usize, loops: &[Vec<Point>]) -> Grid<bool> {
-    let mut rows: Vec<Vec<(f64, i32)>> = vec![Vec::new(); h];
-    for poly in loops {
-        let n = poly.len();
-        for i in 0..n {
-            let (a, b) = (poly[i], poly[(i + 1) % n]);
-            if a.y == b.y {
-                continue;
-            }
-            let (lo, hi) = (a.y.min(b.y), a.y.max(b.y));
-            let r0 = (lo - 0.5).ceil().max(0.0) as usize;
-            let r1 = ((hi - 0.5).ceil().max(0.0) as usize).min(h);
-            let dir = if b.y > a.y { 1 } else { -1 };
-            for (r, row) in rows.iter_mut().enumerate().take(r1).skip(r0) {
-                let y = r as f64 + 0.5;
-                let x = a.x + (y - a.y) / (b.y - a.y) * (b.x - a.x);
-                row.push((x, dir));
-            }
-        }
-    }
     let mut grid = Grid::new(w, h, false);
-    for (r, row) in rows.iter_mut().enumerate() {
-        row.sort_by(|p, q| p.0.total_cmp(&q.0));
-        let mut wind = 0;
-        for k in 0..row.len().saturating_sub(1) {
-            wind += row[k].1;
-            if wind == 0 {
-                continue;
-            }
-            let x0 = (row[k].0 - 0.5).ceil().max(0.0) as usize;
-            let x1 = ((row[k + 1].0 - 0.5).ceil().max(0.0) as usize).min(w);
-            for x in x0..x1 {
-                grid.set(x, r, true);
-            }
-        }
-    }
+    let edges = loops
+        .iter()
+        .flat_map(|poly| (0..poly.len()).map(move |i| (poly[i], poly[(i + 1) % poly.len()])));
+    super::scan::fill(&mut grid, edges, false);
     grid
 }
 

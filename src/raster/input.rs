@@ -512,51 +512,12 @@ const FLATTEN_PX: f64 = 0.01;
 /// counts with each shape's own fill rule.
 fn scan_inside(w: usize, h: usize, shapes: &[FlatShape]) -> Grid<bool> {
     let mut grid = Grid::new(w, h, false);
-    let mut rows: Vec<Vec<(f64, i32)>> = vec![Vec::new(); h];
     for shape in shapes {
-        for r in rows.iter_mut() {
-            r.clear();
-        }
-        for l in &shape.segments {
-            let (a, b) = (l.p0, l.p1);
-            if a.y == b.y {
-                continue;
-            }
-            let (lo, hi) = (a.y.min(b.y), a.y.max(b.y));
-            // Rows whose centre y + 0.5 lies in [lo, hi).
-            let r0 = (lo - 0.5).ceil().max(0.0) as usize;
-            let r1 = ((hi - 0.5).ceil().max(0.0) as usize).min(h);
-            let dir = if b.y > a.y { 1 } else { -1 };
-            for (r, row) in rows.iter_mut().enumerate().take(r1).skip(r0) {
-                let y = r as f64 + 0.5;
-                let x = a.x + (y - a.y) / (b.y - a.y) * (b.x - a.x);
-                row.push((x, dir));
-            }
-        }
-        for (r, row) in rows.iter_mut().enumerate() {
-            if row.is_empty() {
-                continue;
-            }
-            row.sort_by(|p, q| p.0.total_cmp(&q.0));
-            let mut wind = 0;
-            for k in 0..row.len() - 1 {
-                wind += row[k].1;
-                let inside = if shape.even_odd {
-                    wind % 2 != 0
-                } else {
-                    wind != 0
-                };
-                if !inside {
-                    continue;
-                }
-                // Pixel centres x + 0.5 in [row[k].0, row[k + 1].0).
-                let x0 = (row[k].0 - 0.5).ceil().max(0.0) as usize;
-                let x1 = ((row[k + 1].0 - 0.5).ceil().max(0.0) as usize).min(w);
-                for x in x0..x1 {
-                    grid.set(x, r, true);
-                }
-            }
-        }
+        super::scan::fill(
+            &mut grid,
+            shape.segments.iter().map(|l| (l.p0, l.p1)),
+            shape.even_odd,
+        );
     }
     grid
 }

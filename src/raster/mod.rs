@@ -5,6 +5,7 @@
 pub mod binary;
 pub mod edt;
 pub mod input;
+pub mod scan;
 pub mod sdf;
 
 pub use sdf::Sdf;
