@@ -108,7 +108,12 @@ pub struct Exemplar {
     /// How the spine was found.
     pub spine_source: SpineSource,
     /// The smooth spine as a dense polyline from start to end, finest px.
+    /// The ribs run along it extended straight beyond both ends over the
+    /// end ornaments ([`uv::extend_to_ink`]), by `extension` px.
     pub spine: Vec<[f64; 2]>,
+    /// How far the ribs extend the spine beyond its start and its end,
+    /// finest px.
+    pub extension: [f64; 2],
     /// The raw Dijkstra path (finest px) when the spine was traced.
     pub path: Vec<[f64; 2]>,
     /// Rib samples (30–100), finest px.
@@ -163,7 +168,10 @@ impl BrushStyle {
     }
 
     /// [`BrushStyle::load`], also telling what the cache did.
-    pub fn load_with_status(dir: &Path, opts: &AnalysisOptions) -> Result<(BrushStyle, CacheStatus)> {
+    pub fn load_with_status(
+        dir: &Path,
+        opts: &AnalysisOptions,
+    ) -> Result<(BrushStyle, CacheStatus)> {
         let toml_path = dir.join(STYLE_FILE);
         let toml_bytes = crate::io::read_file(&toml_path)?;
         let text = String::from_utf8(toml_bytes.clone())
@@ -205,7 +213,10 @@ impl BrushStyle {
                     let (w, h) = (l.width(), l.height());
                     let same = |g_w: usize, g_h: usize| g_w == w && g_h == h;
                     l.scale.is_finite()
-                        && l.ink.layers.iter().all(|ly| same(ly.sdf.width(), ly.sdf.height()))
+                        && l.ink
+                            .layers
+                            .iter()
+                            .all(|ly| same(ly.sdf.width(), ly.sdf.height()))
                         && same(l.orientation.dir.width(), l.orientation.dir.height())
                         && same(l.orientation.mask.width(), l.orientation.mask.height())
                 })
@@ -219,7 +230,9 @@ impl BrushStyle {
                         self.exemplars
                             .get(r.exemplar as usize)
                             .and_then(|e| e.levels.get(l))
-                            .is_some_and(|lv| (r.x as usize) < lv.width() && (r.y as usize) < lv.height())
+                            .is_some_and(|lv| {
+                                (r.x as usize) < lv.width() && (r.y as usize) < lv.height()
+                            })
                     })
             });
         ok_ex && ok_idx && !self.exemplars.is_empty()
@@ -234,7 +247,10 @@ impl BrushStyle {
             return None;
         }
         let up = lv.orientation.dir.get(x, y);
-        Some(self.sampler.sample(&lv.ink.ink, [x as f64 + 0.5, y as f64 + 0.5], up))
+        Some(
+            self.sampler
+                .sample(&lv.ink.ink, [x as f64 + 0.5, y as f64 + 0.5], up),
+        )
     }
 }
 
@@ -247,7 +263,12 @@ fn style_name(dir: &Path) -> String {
 }
 
 /// Analyses every exemplar of `toml` (from folder `dir`) and indexes them.
-pub fn analyse(dir: &Path, name: &str, toml: &StyleToml, opts: &AnalysisOptions) -> Result<BrushStyle> {
+pub fn analyse(
+    dir: &Path,
+    name: &str,
+    toml: &StyleToml,
+    opts: &AnalysisOptions,
+) -> Result<BrushStyle> {
     let resolution = toml.resolution.unwrap_or(DEFAULT_RESOLUTION);
     let sdf = toml.sdf.unwrap_or(true);
     let sampler = NeighbourhoodSampler {
@@ -379,21 +400,31 @@ fn analyse_exemplar(
         return Err(Error::invalid(&path, "the spine has no length"));
     }
     let coarse = ink.levels[0].px_per_unit / fine_ppu;
-    let n = uv::sample_count(length, coarse);
     let reach = 0.5 * fine.ink.width().max(fine.ink.height()) as f64;
-    let ribs = uv::build_ribs(&spine, n, &fine.ink, 1.0 / coarse, reach);
+    let (extended, extension) = uv::extend_to_ink(&spine, &fine.ink, reach);
+    let n = uv::sample_count(length + extension[0] + extension[1], coarse);
+    let ribs = uv::build_ribs(&extended, n, &fine.ink, 1.0 / coarse, reach);
     let layer_grids: Vec<&crate::raster::Grid<f32>> = fine.layers.iter().map(|l| &l.sdf).collect();
     let features = uv::features(&ribs, &fine.ink, &layer_grids);
     let mut levels = Vec::with_capacity(LEVELS);
     let mut hoods = Vec::with_capacity(LEVELS);
     for lv in ink.levels {
         let scale = lv.px_per_unit / fine_ppu;
-        let field = uv::orientation_field(&ribs.scaled(scale), lv.ink.width(), lv.ink.height(), REGION_MARGIN);
+        let field = uv::orientation_field(
+            &ribs.scaled(scale),
+            lv.ink.width(),
+            lv.ink.height(),
+            REGION_MARGIN,
+        );
         let mut v = Vec::new();
         for y in 0..field.mask.height() {
             for x in 0..field.mask.width() {
                 if field.mask.get(x, y) {
-                    v.push(sampler.sample(&lv.ink, [x as f64 + 0.5, y as f64 + 0.5], field.dir.get(x, y)));
+                    v.push(sampler.sample(
+                        &lv.ink,
+                        [x as f64 + 0.5, y as f64 + 0.5],
+                        field.dir.get(x, y),
+                    ));
                 }
             }
         }
@@ -411,6 +442,7 @@ fn analyse_exemplar(
             size: ink.size,
             spine_source,
             spine: spine.iter().map(arr).collect(),
+            extension,
             path: path_px.iter().map(arr).collect(),
             ribs,
             features,

@@ -155,21 +155,19 @@ fn find_spine(group: &usvg::Group) -> Option<BezPath> {
 
 /// The first subpath of `path` flattened to 0.05 user units.
 fn polyline(path: &BezPath) -> Vec<Point> {
-    let mut pts = Vec::new();
-    let mut started = false;
+    let mut pts: Vec<Point> = Vec::new();
+    // Subpaths seen so far: only the first one is kept.
+    let mut subpaths = 0;
     kurbo::flatten(path, 0.05, |el| match el {
-        PathEl::MoveTo(p) if !started => {
-            started = true;
-            pts.push(p);
-        }
-        PathEl::LineTo(p) if started => {
-            if pts.last() != Some(&p) {
+        PathEl::MoveTo(p) => {
+            subpaths += 1;
+            if subpaths == 1 {
                 pts.push(p);
             }
         }
+        PathEl::LineTo(p) if subpaths == 1 && pts.last() != Some(&p) => pts.push(p),
         _ => {}
     });
-    // Only the first subpath: stop at the second MoveTo.
     pts
 }
 
