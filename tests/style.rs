@@ -65,7 +65,10 @@ fn check_with(toml: &str, blank: bool) -> (Option<i32>, String) {
     }
     let cache = tmp.path().join("cache");
     let out = flourish(&["style", "check", s(&dir), "--cache", s(&cache)]);
-    (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
 }
 
 fn assert_one_line_error(toml: &str, blank: bool, needles: &[&str]) {
@@ -81,8 +84,16 @@ fn assert_one_line_error(toml: &str, blank: bool, needles: &[&str]) {
 #[test]
 fn bad_styles_fail_with_one_clear_line() {
     let ok = TOML;
-    assert_one_line_error(&ok.replace("\"brush\"", "\"sparkle\""), false, &["style.toml", "sparkle"]);
-    assert_one_line_error(&ok.replace("\"a.svg\"", "\"missing.svg\""), false, &["missing.svg"]);
+    assert_one_line_error(
+        &ok.replace("\"brush\"", "\"sparkle\""),
+        false,
+        &["style.toml", "sparkle"],
+    );
+    assert_one_line_error(
+        &ok.replace("\"a.svg\"", "\"missing.svg\""),
+        false,
+        &["missing.svg"],
+    );
     assert_one_line_error(ok, true, &["a.svg", "blank exemplar"]);
     assert_one_line_error(
         &ok.replacen("start = [24.0, 50.0]", "start = [240.0, 50.0]", 1),
@@ -198,7 +209,10 @@ fn cache_hits_misses_and_rebuilds_corrupt_files() {
         use_cache: false,
         ..opts
     };
-    assert_eq!(BrushStyle::load_with_status(&dir, &off).unwrap().1, CacheStatus::Disabled);
+    assert_eq!(
+        BrushStyle::load_with_status(&dir, &off).unwrap().1,
+        CacheStatus::Disabled
+    );
 }
 
 #[test]
@@ -219,12 +233,20 @@ fn analysis_and_sheet_do_not_depend_on_the_thread_count() {
             "--sheet",
             s(&sheet),
         ]);
-        assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         outs.push((out.stdout, std::fs::read(&sheet).unwrap()));
     }
     assert_eq!(outs[0], outs[1]);
     let report = String::from_utf8_lossy(&outs[0].0);
-    assert!(report.contains("a.svg") && report.contains("b.svg"), "{report}");
+    assert!(
+        report.contains("a.svg") && report.contains("b.svg"),
+        "{report}"
+    );
     assert!(report.contains("traced"), "{report}");
     assert!(outs[0].1.starts_with(b"\x89PNG"));
 }

@@ -339,7 +339,9 @@ pub fn features(ribs: &Ribs, ink: &Grid<f32>, layers: &[&Grid<f32>]) -> Vec<Samp
 }
 
 /// The per-pixel stroking orientation and the stroke region of one level.
+/// (Cached as the mask and the orientations of masked pixels only.)
 #[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(into = "SparseOrientation", try_from = "SparseOrientation")]
 pub struct OrientationField {
     /// Unit orientation `ω = [ω_x, ω_y]` per pixel (pixel axes, y down):
     /// the direction of travel along the stroke; `[0, 0]` outside the
@@ -348,6 +350,50 @@ pub struct OrientationField {
     /// The stroke region: pixels covered by the rib quads (outlines pushed
     /// out by the margin).
     pub mask: Grid<bool>,
+}
+
+/// The cached form of an [`OrientationField`]: the mask, and the
+/// orientations of the masked pixels in row-major order.
+#[derive(Clone, Serialize, Deserialize)]
+struct SparseOrientation {
+    #[serde(with = "crate::raster::plain::bits")]
+    mask: Grid<bool>,
+    #[serde(with = "crate::raster::plain::vec")]
+    dirs: Vec<[f32; 2]>,
+}
+
+impl From<OrientationField> for SparseOrientation {
+    fn from(f: OrientationField) -> Self {
+        let dirs = f
+            .dir
+            .data()
+            .iter()
+            .zip(f.mask.data())
+            .filter(|(_, &m)| m)
+            .map(|(d, _)| *d)
+            .collect();
+        SparseOrientation { mask: f.mask, dirs }
+    }
+}
+
+impl TryFrom<SparseOrientation> for OrientationField {
+    type Error = String;
+    fn try_from(s: SparseOrientation) -> Result<Self, String> {
+        let n = s.mask.data().iter().filter(|&&m| m).count();
+        if n != s.dirs.len() {
+            return Err("orientation count does not match the mask".into());
+        }
+        let mut dir = Grid::new(s.mask.width(), s.mask.height(), [0.0f32; 2]);
+        let mut it = s.dirs.into_iter();
+        for (d, &m) in dir.data_mut().iter_mut().zip(s.mask.data()) {
+            if m {
+                if let Some(v) = it.next() {
+                    *d = v;
+                }
+            }
+        }
+        Ok(OrientationField { dir, mask: s.mask })
+    }
 }
 
 /// The direction of travel implied by an outline rib `o − x`: the rib
