@@ -263,10 +263,12 @@ pub fn thin_ink(ink: &Grid<f32>, coarse: f64, thin_px: f64) -> f64 {
     }
 }
 
-/// Side of one exemplar's panel on the sheet, px.
-pub const PANEL: u32 = 240;
+/// Width of one exemplar's panel on the sheet, px.
+pub const PANEL_W: u32 = 300;
+/// Height of one exemplar's panel on the sheet, px.
+pub const PANEL_H: u32 = 150;
 /// Panels per row on the sheet.
-pub const COLUMNS: u32 = 5;
+pub const COLUMNS: u32 = 3;
 
 /// The diagnostics sheet as PNG bytes: one panel per exemplar (row-major in
 /// `style.toml` order) showing the ink in its layer colours over the stroke
@@ -277,32 +279,66 @@ pub fn sheet_png(style: &BrushStyle, out: &Path) -> Result<Vec<u8>> {
     let n = style.exemplars.len().max(1) as u32;
     let cols = n.min(COLUMNS);
     let rows = n.div_ceil(COLUMNS);
-    let mut pm = tiny_skia::Pixmap::new(cols * PANEL, rows * PANEL)
+    let mut pm = tiny_skia::Pixmap::new(cols * PANEL_W, rows * PANEL_H)
         .ok_or_else(|| Error::invalid(out, "cannot allocate the sheet"))?;
     pm.fill(tiny_skia::Color::WHITE);
     for (i, e) in style.exemplars.iter().enumerate() {
-        let (cx, cy) = ((i as u32 % COLUMNS) * PANEL, (i as u32 / COLUMNS) * PANEL);
+        let (cx, cy) = (
+            (i as u32 % COLUMNS) * PANEL_W,
+            (i as u32 / COLUMNS) * PANEL_H,
+        );
         draw_panel(&mut pm, e, cx as f32, cy as f32);
     }
-    pm.encode_png()
-        .map_err(|e| Error::invalid(out, format!("PNG encoding failed: {e}")))
+    // Opaque pixels: premultiplied RGBA is plain RGBA. Encoded with the
+    // best compression, the sheets stay small enough for a README.
+    let mut png = Vec::new();
+    let enc = image::codecs::png::PngEncoder::new_with_quality(
+        &mut png,
+        image::codecs::png::CompressionType::Best,
+        image::codecs::png::FilterType::Adaptive,
+    );
+    image::ImageEncoder::write_image(
+        enc,
+        pm.data(),
+        pm.width(),
+        pm.height(),
+        image::ExtendedColorType::Rgba8,
+    )
+    .map_err(|e| Error::invalid(out, format!("PNG encoding failed: {e}")))?;
+    Ok(png)
 }
 
 fn draw_panel(pm: &mut tiny_skia::Pixmap, e: &Exemplar, ox: f32, oy: f32) {
     let Some(f) = e.finest() else { return };
-    let side = f.width().max(f.height()) as f32;
-    let k = (PANEL as f32 - 8.0) / side; // panel px per finest px
-    let (px0, py0) = (ox + 4.0, oy + 4.0);
+    // The panel shows the bounding box of ink and stroke region, padded.
+    let (mut x0, mut y0, mut x1, mut y1) = (f.width(), f.height(), 0, 0);
+    for y in 0..f.height() {
+        for x in 0..f.width() {
+            if f.orientation.mask.get(x, y) || f.ink.ink.get(x, y) < 0.0 {
+                (x0, y0, x1, y1) = (x0.min(x), y0.min(y), x1.max(x + 1), y1.max(y + 1));
+            }
+        }
+    }
+    if x1 <= x0 || y1 <= y0 {
+        (x0, y0, x1, y1) = (0, 0, f.width(), f.height());
+    }
+    let pad = 0.03 * (x1 - x0).max(y1 - y0) as f32;
+    let (bx, by) = (x0 as f32 - pad, y0 as f32 - pad);
+    let (bw, bh) = ((x1 - x0) as f32 + 2.0 * pad, (y1 - y0) as f32 + 2.0 * pad);
+    // Panel px per finest px, and the offset that centres the box.
+    let k = ((PANEL_W as f32 - 8.0) / bw).min((PANEL_H as f32 - 8.0) / bh);
+    let tx = (PANEL_W as f32 - bw * k) / 2.0;
+    let ty = (PANEL_H as f32 - bh * k) / 2.0;
+    let to_fine = |x: f32, y: f32| ((x - tx) / k + bx, (y - ty) / k + by);
     // Ink and stroke region, per panel pixel.
     let (w, h) = (pm.width(), pm.height());
-    for y in 0..PANEL {
-        for x in 0..PANEL {
+    for y in 0..PANEL_H {
+        for x in 0..PANEL_W {
             let (gx, gy) = (ox as u32 + x, oy as u32 + y);
             if gx >= w || gy >= h {
                 continue;
             }
-            let fx = (x as f32 + 0.5 - 4.0) / k;
-            let fy = (y as f32 + 0.5 - 4.0) / k;
+            let (fx, fy) = to_fine(x as f32 + 0.5, y as f32 + 0.5);
             if fx < 0.0 || fy < 0.0 || fx >= f.width() as f32 || fy >= f.height() as f32 {
                 continue;
             }
@@ -331,7 +367,12 @@ fn draw_panel(pm: &mut tiny_skia::Pixmap, e: &Exemplar, ox: f32, oy: f32) {
             }
         }
     }
-    let map = |p: [f64; 2]| (px0 + p[0] as f32 * k, py0 + p[1] as f32 * k);
+    let map = |p: [f64; 2]| {
+        (
+            ox + tx + (p[0] as f32 - bx) * k,
+            oy + ty + (p[1] as f32 - by) * k,
+        )
+    };
     let line = |pm: &mut tiny_skia::Pixmap, pts: &[(f32, f32)], rgba: [u8; 4], width: f32| {
         let mut pb = tiny_skia::PathBuilder::new();
         for (j, &(x, y)) in pts.iter().enumerate() {
@@ -386,14 +427,13 @@ fn draw_panel(pm: &mut tiny_skia::Pixmap, e: &Exemplar, ox: f32, oy: f32) {
     let right: Vec<_> = e.ribs.right.iter().map(|&p| map(p)).collect();
     line(pm, &left, [90, 90, 90, 200], 0.9);
     line(pm, &right, [90, 90, 90, 200], 0.9);
-    // Orientation field: ticks on a 10 px panel grid inside the region.
-    let step = 10.0;
+    // Orientation field: ticks on a 12 px panel grid inside the region.
+    let step = 12.0;
     let mut y = step / 2.0;
-    while y < PANEL as f32 - 4.0 {
+    while y < PANEL_H as f32 {
         let mut x = step / 2.0;
-        while x < PANEL as f32 - 4.0 {
-            let fx = (x - 4.0) / k;
-            let fy = (y - 4.0) / k;
+        while x < PANEL_W as f32 {
+            let (fx, fy) = to_fine(x, y);
             if fx >= 0.0 && fy >= 0.0 && (fx as usize) < f.width() && (fy as usize) < f.height() {
                 let (ix, iy) = (fx as usize, fy as usize);
                 if f.orientation.mask.get(ix, iy) {
