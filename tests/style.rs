@@ -200,10 +200,17 @@ fn cache_hits_misses_and_rebuilds_corrupt_files() {
             assert_eq!(st, CacheStatus::Hit);
         }
     }
-    // Editing an exemplar changes the key: a miss, not the old analysis.
+    // Editing an exemplar changes the key: a miss, not the old analysis,
+    // and the stale file is replaced, not kept beside the new one.
     std::fs::write(dir.join("b.svg"), exemplar_svg(2.0)).unwrap();
     let (_, st) = BrushStyle::load_with_status(&dir, &opts).unwrap();
     assert_eq!(st, CacheStatus::Miss);
+    let after: Vec<_> = std::fs::read_dir(tmp.path().join("cache"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    assert_eq!(after.len(), 1, "{after:?}");
+    assert_ne!(&after[0], file);
     // Caching off.
     let off = AnalysisOptions {
         use_cache: false,
