@@ -180,12 +180,8 @@ impl StyleToml {
             }
         }
         if self.kind == StyleKind::Brush {
-            if self.exemplar.is_empty() {
-                return bad(
-                    "exemplar",
-                    "a brush style needs at least one [[exemplar]] table".into(),
-                );
-            }
+            // (An empty library is refused by the brush analysis itself, so
+            // other commands report the wrong kind first.)
             for (i, ex) in self.exemplar.iter().enumerate() {
                 for (key, p) in [("start", ex.start), ("end", ex.end)] {
                     if let Some([x, y]) = p {
