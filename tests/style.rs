@@ -369,3 +369,43 @@ fn rotating_an_exemplar_rotates_its_orientation_and_neighbourhoods() {
     );
     assert!(close * 100 > both * 95, "neighbourhoods: {close} of {both}");
 }
+
+#[test]
+fn png_exemplars_are_analysed_too() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("png");
+    std::fs::create_dir_all(&dir).unwrap();
+    // A dark band with a round end on white, 160×80 px.
+    let img = image::RgbImage::from_fn(160, 80, |x, y| {
+        let (px, py) = (x as f64 + 0.5, y as f64 + 0.5);
+        let band = (20.0..130.0).contains(&px) && (py - 40.0).abs() < 6.0;
+        let ball = (px - 134.0).hypot(py - 40.0) < 10.0;
+        if band || ball {
+            image::Rgb([30, 40, 60])
+        } else {
+            image::Rgb([255, 255, 255])
+        }
+    });
+    img.save(dir.join("band.png")).unwrap();
+    std::fs::write(
+        dir.join("style.toml"),
+        "kind = \"brush\"\nresolution = 128\n[[exemplar]]\nfile = \"band.png\"\nstart = [30.0, 40.0]\nend = [125.0, 40.0]\n",
+    )
+    .unwrap();
+    let opts = AnalysisOptions {
+        use_cache: false,
+        ..AnalysisOptions::default()
+    };
+    let st = BrushStyle::load(&dir, &opts).unwrap();
+    let ex = &st.exemplars[0];
+    assert_eq!(ex.size, [160.0, 80.0]);
+    let fine = ex.finest().unwrap();
+    assert_eq!((fine.width(), fine.height()), (128, 64));
+    // Widths along the band: 12 px × 0.8 = 9.6 finest px, within a pixel,
+    // away from the ball; the spine is extended over the ball.
+    let w = ex.ribs.widths();
+    let mid = &w[w.len() / 4..w.len() / 2];
+    assert!(mid.iter().all(|&x| (x - 9.6).abs() < 1.0), "{mid:?}");
+    assert!(ex.extension[1] > 10.0, "{:?}", ex.extension);
+    assert!(st.indexes.iter().all(|i| !i.is_empty()));
+}
