@@ -5,6 +5,7 @@
 pub mod binary;
 pub mod edt;
 pub mod input;
+pub mod plain;
 pub mod scan;
 pub mod sdf;
 
