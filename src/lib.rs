@@ -14,6 +14,7 @@
 pub mod diff;
 pub mod error;
 pub mod field;
+pub mod fill;
 pub mod io;
 pub mod pattern;
 pub mod raster;

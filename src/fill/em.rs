@@ -1,0 +1,454 @@
+//! The multiresolution EM loop of art-pattern-level-sets Alg. 1, with the
+//! direction-aware matching and coherence-weighted voting of Brushables.
+//!
+//! Per level, coarse to fine: initialize (quilting at the coarsest level,
+//! upsampling otherwise), then for each neighbourhood size and each of `N`
+//! iterations: **M-step** — PatchMatch over all channels (Eq. 6 distance,
+//! target patches rotated by the direction difference); **E-step** — every
+//! SDF channel moved by the level set with the mean matched SDF as data
+//! (Eq. 4) and curvature regularization (Eq. 5), weights `λ: 0.2 → 0.95`,
+//! `μ: 0.8 → 0.05` in steps of `0.75/N` (Alg. 1); the colour channels
+//! voted with the coherence weight of Brushables Eq. 7–8. The histogram
+//! weight of Eq. 7 is left out (weight 1): fills have few flat colours.
+//!
+//! The energy (Eq. 6) of the current image against the matches after each
+//! M-step is recorded per level, so its decrease can be checked.
+
+use super::levelset::{self, Evolution};
+use super::patchmatch::{Channels, Match, Nnf, Patch, Problem};
+use super::quilt::{self, QuiltOptions};
+use super::tile::Tile;
+use crate::field::DirectionGrid;
+use crate::raster::Grid;
+use rayon::prelude::*;
+
+/// Parameters of the synthesis.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EmParams {
+    /// Colour weight `α` of Eq. 6 (SDF weight `1 − α`).
+    pub alpha: f32,
+    /// Finest patch radius `r` (patches are `(2r+1)²`).
+    pub radius: usize,
+    /// Pyramid levels (1 = finest only).
+    pub levels: usize,
+    /// EM iterations `N` per neighbourhood size (halved at the finest level).
+    pub iterations: usize,
+    /// Level-set time steps per E-step (the paper uses 5).
+    pub steps: usize,
+    /// Seed of every random choice.
+    pub seed: u64,
+}
+
+impl Default for EmParams {
+    fn default() -> Self {
+        EmParams {
+            alpha: 0.25,
+            radius: 4,
+            levels: 3,
+            iterations: 4,
+            steps: 5,
+            seed: 0,
+        }
+    }
+}
+
+/// The synthesized image at the finest level.
+#[derive(Clone, Debug)]
+pub struct Synthesis {
+    /// One SDF per tile layer, target pixels, negative inside.
+    pub layers: Vec<Grid<f32>>,
+    /// Voted colour (0..1 RGB).
+    pub colour: Grid<[f32; 3]>,
+    /// Eq. 6 energy after each M-step, per level (coarse first), per
+    /// neighbourhood size and iteration in order.
+    pub energy: Vec<Vec<f64>>,
+}
+
+/// The image being synthesized at one level.
+struct State {
+    phi: Vec<Grid<f32>>,
+    colour: Grid<[f32; 3]>,
+}
+
+/// Synthesizes a `width`×`height` image from `tile` (finest level), whose
+/// texture follows `direction` (a unit vector per target pixel).
+pub fn synthesize(tile: &Tile, direction: &DirectionGrid, params: &EmParams) -> Synthesis {
+    let (width, height) = (direction.width(), direction.height());
+    let levels = params.levels.max(1);
+    let mut tiles = vec![tile.clone()];
+    for _ in 1..levels {
+        let t = tiles[tiles.len() - 1].half();
+        tiles.push(t);
+    }
+    let mut state: Option<State> = None;
+    let mut nnf: Option<Nnf> = None;
+    let mut energy = Vec::new();
+    for level in (0..levels).rev() {
+        let t = &tiles[level];
+        let f = 1usize << level;
+        let (w, h) = (width.div_ceil(f).max(1), height.div_ceil(f).max(1));
+        let target_angle = Grid::from_fn(w, h, |x, y| {
+            let d = direction.get(
+                (x * f + f / 2).min(width - 1),
+                (y * f + f / 2).min(height - 1),
+            );
+            d[1].atan2(d[0])
+        });
+        let source_angle = t.direction.map(|d| d[1].atan2(d[0]));
+        // Neighbourhood sizes: at the coarsest level a larger one first.
+        let max_r = (t.width().min(t.height()) / 4).max(1);
+        let mut radii = vec![params.radius.min(max_r).max(1)];
+        if level + 1 == levels && levels > 1 && 2 * radii[0] <= max_r {
+            radii.insert(0, 2 * radii[0]);
+        }
+        let clamp = (params.radius as f32 + 1.0).max(2.0);
+        let source = channels_of(
+            &t.layers.iter().map(|l| l.sdf.clone()).collect::<Vec<_>>(),
+            &t.colour,
+            params.alpha,
+            clamp,
+        );
+        let mut st = match state.take() {
+            None => {
+                // Quilting with blocks of two patches.
+                let block = (4 * radii[0] + 2).min(t.width().min(t.height()));
+                let map = quilt::quilt(
+                    &source,
+                    &source_angle,
+                    &target_angle,
+                    &QuiltOptions {
+                        block,
+                        overlap: (block / 4).max(1),
+                        candidates: 4096,
+                        seed: params.seed,
+                    },
+                );
+                let phi = t
+                    .layers
+                    .iter()
+                    .map(|l| {
+                        Grid::from_fn(w, h, |x, y| {
+                            let (sx, sy) = map.get(x, y);
+                            l.sdf.get(sx as usize, sy as usize)
+                        })
+                    })
+                    .collect();
+                let colour = Grid::from_fn(w, h, |x, y| {
+                    let (sx, sy) = map.get(x, y);
+                    t.colour.get(sx as usize, sy as usize)
+                });
+                let spacing = spacing_of(radii[0]);
+                let (cols, rows) = Nnf::shape(w, h, spacing);
+                let matches = (0..cols * rows)
+                    .map(|k| {
+                        let (sx, sy) = map.get(
+                            ((k % cols) * spacing).min(w - 1),
+                            ((k / cols) * spacing).min(h - 1),
+                        );
+                        Match {
+                            x: sx,
+                            y: sy,
+                            cost: f32::INFINITY,
+                        }
+                    })
+                    .collect();
+                nnf = Some(Nnf {
+                    cols,
+                    rows,
+                    spacing,
+                    matches,
+                });
+                State { phi, colour }
+            }
+            Some(prev) => upsample(&prev, w, h),
+        };
+        let mut level_energy = Vec::new();
+        for (ri, &r) in radii.iter().enumerate() {
+            let patch = Patch::new(r);
+            let spacing = spacing_of(r);
+            let mut field = resample_nnf(nnf.take(), w, h, spacing, t);
+            let n = if level == 0 && levels > 1 {
+                params.iterations.div_ceil(2)
+            } else {
+                params.iterations
+            }
+            .max(1);
+            let (mut lambda, mut mu) = (0.2f32, 0.8f32);
+            for it in 0..n {
+                let target = channels_of(&st.phi, &st.colour, params.alpha, clamp);
+                let pb = Problem {
+                    source: &source,
+                    source_angle: &source_angle,
+                    target: &target,
+                    target_angle: &target_angle,
+                    patch: &patch,
+                };
+                pb.refresh(&mut field);
+                let round = ((level * 8 + ri) * 64 + it) as u64;
+                pb.improve(&mut field, params.seed, round);
+                level_energy.push(field.matches.iter().map(|m| m.cost as f64).sum::<f64>());
+                // E-step.
+                let votes = vote(&pb, &field, t, w, h);
+                // Curvature flow smooths a length scale √t: scaled by 4^-level it
+                // acts on the same length in finest pixels at every level.
+                let mu_level = mu / (1u32 << (2 * level)) as f32;
+                let ev = Evolution {
+                    lambda,
+                    mu: mu_level,
+                    dt: 0.2,
+                    steps: params.steps,
+                    band: r as f32 + 2.0,
+                };
+                for (phi, (mean, count)) in st.phi.iter_mut().zip(&votes.sdf) {
+                    levelset::evolve(phi, mean, count, &ev);
+                }
+                st.colour = votes.colour;
+                lambda += 0.75 / n as f32;
+                mu -= 0.75 / n as f32;
+            }
+            nnf = Some(field);
+        }
+        energy.push(level_energy);
+        state = Some(st);
+    }
+    let st = state.unwrap_or_else(|| State {
+        phi: Vec::new(),
+        colour: Grid::new(width, height, [1.0; 3]),
+    });
+    Synthesis {
+        layers: st.phi,
+        colour: st.colour,
+        energy,
+    }
+}
+
+/// Centre spacing `w/4` of art-pattern-level-sets §2 (at least 1).
+fn spacing_of(r: usize) -> usize {
+    ((2 * r + 1) / 4).max(1)
+}
+
+/// The weighted channel image: `√(1−α)·clamp(Φ/K)` per layer, then
+/// `√α·rgb`, so a plain SSD is the Eq. 6 energy.
+pub fn channels_of(phi: &[Grid<f32>], colour: &Grid<[f32; 3]>, alpha: f32, clamp: f32) -> Channels {
+    let (w, h) = (colour.width(), colour.height());
+    let (wd, wa) = ((1.0 - alpha).max(0.0).sqrt(), alpha.max(0.0).sqrt());
+    let depth = phi.len() + 3;
+    let mut data = Vec::with_capacity(w * h * depth);
+    for y in 0..h {
+        for x in 0..w {
+            for p in phi {
+                data.push(wd * p.get(x, y).clamp(-clamp, clamp) / clamp);
+            }
+            data.extend(colour.get(x, y).map(|c| wa * c));
+        }
+    }
+    Channels {
+        width: w,
+        height: h,
+        depth,
+        data,
+    }
+}
+
+/// The previous field brought to a new spacing or resolution: each new
+/// centre takes the match of the nearest old centre (scaled by 2 across a
+/// level, CaTS Alg. 2) shifted by the offset between them.
+fn resample_nnf(old: Option<Nnf>, w: usize, h: usize, spacing: usize, t: &Tile) -> Nnf {
+    let (cols, rows) = Nnf::shape(w, h, spacing);
+    let (tw, th) = (t.width() as i64, t.height() as i64);
+    let matches = match &old {
+        None => vec![
+            Match {
+                x: 0,
+                y: 0,
+                cost: f32::INFINITY
+            };
+            cols * rows
+        ],
+        Some(o) => {
+            // Old target extent in pixels decides the scale factor.
+            let old_w = (o.cols - 1) * o.spacing + 1;
+            let scale = if old_w * 2 <= w + 2 * o.spacing { 2 } else { 1 };
+            (0..cols * rows)
+                .map(|k| {
+                    let (qx, qy) = ((k % cols) * spacing, (k / cols) * spacing);
+                    let (cx, cy) = (qx / scale, qy / scale);
+                    let i = ((cx + o.spacing / 2) / o.spacing).min(o.cols - 1);
+                    let j = ((cy + o.spacing / 2) / o.spacing).min(o.rows - 1);
+                    let m = o.matches[j * o.cols + i];
+                    let ox = qx as i64 - (i * o.spacing * scale) as i64;
+                    let oy = qy as i64 - (j * o.spacing * scale) as i64;
+                    Match {
+                        x: ((m.x as i64 * scale as i64 + ox).rem_euclid(tw)) as u32,
+                        y: ((m.y as i64 * scale as i64 + oy).rem_euclid(th)) as u32,
+                        cost: f32::INFINITY,
+                    }
+                })
+                .collect()
+        }
+    };
+    Nnf {
+        cols,
+        rows,
+        spacing,
+        matches,
+    }
+}
+
+/// Bilinear upsampling to the next level: distances doubled (pixel unit
+/// halves), colours interpolated.
+fn upsample(prev: &State, w: usize, h: usize) -> State {
+    let (pw, ph) = (prev.colour.width(), prev.colour.height());
+    let pos = |x: usize, y: usize| {
+        (
+            (x as f64 + 0.5) * pw as f64 / w as f64,
+            (y as f64 + 0.5) * ph as f64 / h as f64,
+        )
+    };
+    let phi = prev
+        .phi
+        .iter()
+        .map(|g| {
+            Grid::from_fn(w, h, |x, y| {
+                let (u, v) = pos(x, y);
+                2.0 * g.sample(u, v)
+            })
+        })
+        .collect();
+    let chans: Vec<Grid<f32>> = (0..3).map(|k| prev.colour.map(|c| c[k])).collect();
+    let colour = Grid::from_fn(w, h, |x, y| {
+        let (u, v) = pos(x, y);
+        [
+            chans[0].sample(u, v),
+            chans[1].sample(u, v),
+            chans[2].sample(u, v),
+        ]
+    });
+    State { phi, colour }
+}
+
+/// One pixel's gathered votes: mean SDF per layer, count, colour.
+type PixelVote = (Vec<f32>, f32, [f32; 3]);
+
+/// What the matched neighbourhoods say about each pixel.
+struct Votes {
+    /// Per layer: mean matched SDF (tile px ≡ target px) and count.
+    sdf: Vec<(Grid<f32>, Grid<f32>)>,
+    /// Coherence-weighted colour (Brushables Eq. 7).
+    colour: Grid<[f32; 3]>,
+}
+
+/// Brushables Eq. 8: how well the rigid maps of neighbouring centres agree
+/// with centre `k`'s own (σ_c² = 2), averaged, plus a floor.
+fn coherence(pb: &Problem, nnf: &Nnf, k: usize) -> f32 {
+    let r = pb.patch.radius;
+    let (qx, qy) = nnf.centre(k);
+    let m = nnf.matches[k];
+    let (tw, th) = (pb.source.width as i64, pb.source.height as i64);
+    let (ci, cj) = (k % nnf.cols, k / nnf.cols);
+    let reach = (r / nnf.spacing).max(1);
+    let (mut sum, mut n) = (0.0f32, 0u32);
+    for j in cj.saturating_sub(reach)..=(cj + reach).min(nnf.rows - 1) {
+        for i in ci.saturating_sub(reach)..=(ci + reach).min(nnf.cols - 1) {
+            if (i, j) == (ci, cj) {
+                continue;
+            }
+            let o = nnf.matches[j * nnf.cols + i];
+            let (dx, dy) = (
+                (i * nnf.spacing) as i32 - qx as i32,
+                (j * nnf.spacing) as i32 - qy as i32,
+            );
+            let (px, py) = pb.map(qx, qy, m.x as usize, m.y as usize, dx, dy);
+            // Torus distance between the two images of the neighbour.
+            let ex = (px as i64 - o.x as i64).rem_euclid(tw);
+            let ey = (py as i64 - o.y as i64).rem_euclid(th);
+            let (ex, ey) = (ex.min(tw - ex) as f32, ey.min(th - ey) as f32);
+            sum += (-(ex * ex + ey * ey) / (2.0 * 2.0)).exp();
+            n += 1;
+        }
+    }
+    1e-3 + if n > 0 { sum / n as f32 } else { 1.0 }
+}
+
+/// The E-step's gathering: every pixel collects the tile values its
+/// overlapping matched neighbourhoods put there.
+fn vote(pb: &Problem, nnf: &Nnf, t: &Tile, w: usize, h: usize) -> Votes {
+    let weights: Vec<f32> = (0..nnf.matches.len())
+        .into_par_iter()
+        .map(|k| coherence(pb, nnf, k))
+        .collect();
+    let r = pb.patch.radius as i64;
+    let s = nnf.spacing as i64;
+    let side = 2 * r + 1;
+    let layers = t.layers.len();
+    let rows: Vec<Vec<PixelVote>> = (0..h)
+        .into_par_iter()
+        .map(|y| {
+            (0..w)
+                .map(|x| {
+                    let mut sdf = vec![0.0f32; layers];
+                    let mut count = 0.0f32;
+                    let (mut col, mut wsum) = ([0.0f32; 3], 0.0f32);
+                    let (x, y) = (x as i64, y as i64);
+                    let (i0, i1) = (
+                        ((x - r).max(0) + s - 1) / s,
+                        ((x + r) / s).min(nnf.cols as i64 - 1),
+                    );
+                    let (j0, j1) = (
+                        ((y - r).max(0) + s - 1) / s,
+                        ((y + r) / s).min(nnf.rows as i64 - 1),
+                    );
+                    for j in j0..=j1 {
+                        for i in i0..=i1 {
+                            let k = (j * nnf.cols as i64 + i) as usize;
+                            let m = nnf.matches[k];
+                            let (qx, qy) = (i * s, j * s);
+                            let (dx, dy) = (x - qx, y - qy);
+                            let b = pb.bin(m.x as usize, m.y as usize, qx as usize, qy as usize);
+                            let e = pb.patch.table(b)[((dy + r) * side + dx + r) as usize];
+                            let sx =
+                                (m.x as i64 + e.2 as i64).rem_euclid(t.width() as i64) as usize;
+                            let sy =
+                                (m.y as i64 + e.3 as i64).rem_euclid(t.height() as i64) as usize;
+                            for (acc, l) in sdf.iter_mut().zip(&t.layers) {
+                                *acc += l.sdf.get(sx, sy);
+                            }
+                            count += 1.0;
+                            let wc = weights[k];
+                            let c = t.colour.get(sx, sy);
+                            for q in 0..3 {
+                                col[q] += wc * c[q];
+                            }
+                            wsum += wc;
+                        }
+                    }
+                    if count > 0.0 {
+                        for v in &mut sdf {
+                            *v /= count;
+                        }
+                    }
+                    let col = if wsum > 0.0 {
+                        col.map(|c| c / wsum)
+                    } else {
+                        [1.0; 3]
+                    };
+                    (sdf, count, col)
+                })
+                .collect()
+        })
+        .collect();
+    let mut sdf: Vec<(Grid<f32>, Grid<f32>)> = (0..layers)
+        .map(|_| (Grid::new(w, h, 0.0), Grid::new(w, h, 0.0)))
+        .collect();
+    let mut colour = Grid::new(w, h, [1.0f32; 3]);
+    for (y, row) in rows.into_iter().enumerate() {
+        for (x, (v, count, c)) in row.into_iter().enumerate() {
+            for (m, (mean, cnt)) in sdf.iter_mut().enumerate() {
+                mean.set(x, y, v[m]);
+                cnt.set(x, y, count);
+            }
+            colour.set(x, y, c);
+        }
+    }
+    Votes { sdf, colour }
+}
