@@ -189,9 +189,11 @@ pub fn synthesize(tile: &Tile, direction: &DirectionGrid, params: &EmParams) -> 
                 level_energy.push(field.matches.iter().map(|m| m.cost as f64).sum::<f64>());
                 // E-step.
                 let votes = vote(&pb, &field, t, w, h);
-                // Curvature flow smooths a length scale √t: scaled by 4^-level it
-                // acts on the same length in finest pixels at every level.
-                let mu_level = mu / (1u32 << (2 * level)) as f32;
+                // Eq. 4 sums the data force over the |s_x| overlapping
+                // neighbourhoods; the level set uses their mean, so the
+                // curvature weight is divided by |s_x| to keep Eq. 5's balance.
+                let overlap = ((2 * r + 1) as f32 / spacing as f32).powi(2);
+                let mu_level = mu / overlap;
                 let ev = Evolution {
                     lambda,
                     mu: mu_level,

@@ -136,7 +136,9 @@ impl Tile {
     }
 
     /// The tile at half resolution: 2×2 box means (wrapping), distances
-    /// halved to the new pixel unit, directions averaged and renormalized.
+    /// halved to the new pixel unit and re-measured exactly from the new
+    /// zero level (as the E-step's reinitialization measures the target),
+    /// directions averaged and renormalized.
     pub fn half(&self) -> Tile {
         let (w, h) = ((self.width() / 2).max(1), (self.height() / 2).max(1));
         let (sw, sh) = (self.width(), self.height());
@@ -149,7 +151,7 @@ impl Tile {
             .iter()
             .map(|l| TileLayer {
                 color: l.color,
-                sdf: Grid::from_fn(w, h, |x, y| 0.5 * avg(&l.sdf, x, y)),
+                sdf: periodic_sdf(&Grid::from_fn(w, h, |x, y| 0.5 * avg(&l.sdf, x, y))),
             })
             .collect::<Vec<_>>();
         let colour = composite(&layers, w, h);
