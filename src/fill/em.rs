@@ -59,8 +59,8 @@ pub struct Synthesis {
     pub layers: Vec<Grid<f32>>,
     /// Voted colour (0..1 RGB).
     pub colour: Grid<[f32; 3]>,
-    /// Eq. 6 energy after each M-step, per level (coarse first), per
-    /// neighbourhood size and iteration in order.
+    /// Eq. 6 energy after each M-step ([`interior_energy`]), per level
+    /// (coarse first), per neighbourhood size and iteration in order.
     pub energy: Vec<Vec<f64>>,
 }
 
@@ -176,17 +176,11 @@ pub fn synthesize(tile: &Tile, direction: &DirectionGrid, params: &EmParams) -> 
             let (mut lambda, mut mu) = (0.2f32, 0.8f32);
             for it in 0..n {
                 let target = channels_of(&st.phi, &st.colour, params.alpha, clamp);
-                let pb = Problem {
-                    source: &source,
-                    source_angle: &source_angle,
-                    target: &target,
-                    target_angle: &target_angle,
-                    patch: &patch,
-                };
+                let pb = Problem::new(&source, &source_angle, &target, &target_angle, &patch);
                 pb.refresh(&mut field);
                 let round = ((level * 8 + ri) * 64 + it) as u64;
                 pb.improve(&mut field, params.seed, round);
-                level_energy.push(field.matches.iter().map(|m| m.cost as f64).sum::<f64>());
+                level_energy.push(interior_energy(&field, r, w, h));
                 // E-step.
                 let votes = vote(&pb, &field, t, w, h);
                 // Eq. 4 sums the data force over the |s_x| overlapping
@@ -222,6 +216,20 @@ pub fn synthesize(tile: &Tile, direction: &DirectionGrid, params: &EmParams) -> 
         colour: st.colour,
         energy,
     }
+}
+
+/// Eq. 6 over the neighbourhoods that lie inside the grid (those crossing
+/// its edge compare clamped pixels and are not neighbourhoods of `X`).
+pub fn interior_energy(nnf: &Nnf, r: usize, w: usize, h: usize) -> f64 {
+    nnf.matches
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| {
+            let (x, y) = nnf.centre(*k);
+            x >= r && y >= r && x + r < w && y + r < h
+        })
+        .map(|(_, m)| m.cost as f64)
+        .sum()
 }
 
 /// Centre spacing `w/4` of art-pattern-level-sets §2 (at least 1).
@@ -329,9 +337,6 @@ fn upsample(prev: &State, w: usize, h: usize) -> State {
     State { phi, colour }
 }
 
-/// One pixel's gathered votes: mean SDF per layer, count, colour.
-type PixelVote = (Vec<f32>, f32, [f32; 3]);
-
 /// What the matched neighbourhoods say about each pixel.
 struct Votes {
     /// Per layer: mean matched SDF (tile px ≡ target px) and count.
@@ -373,70 +378,75 @@ fn coherence(pb: &Problem, nnf: &Nnf, k: usize) -> f32 {
 }
 
 /// The E-step's gathering: every pixel collects the tile values its
-/// overlapping matched neighbourhoods put there.
+/// overlapping matched neighbourhoods put there. Rows are gathered in
+/// parallel, each scanning the centres whose patches cross it.
 fn vote(pb: &Problem, nnf: &Nnf, t: &Tile, w: usize, h: usize) -> Votes {
-    let weights: Vec<f32> = (0..nnf.matches.len())
+    let per_centre: Vec<(f32, usize)> = (0..nnf.matches.len())
         .into_par_iter()
-        .map(|k| coherence(pb, nnf, k))
+        .map(|k| {
+            let (qx, qy) = nnf.centre(k);
+            let m = nnf.matches[k];
+            (
+                coherence(pb, nnf, k),
+                pb.bin(m.x as usize, m.y as usize, qx, qy),
+            )
+        })
         .collect();
     let r = pb.patch.radius as i64;
     let s = nnf.spacing as i64;
     let side = 2 * r + 1;
     let layers = t.layers.len();
-    let rows: Vec<Vec<PixelVote>> = (0..h)
+    let (tw, th) = (t.width() as i64, t.height() as i64);
+    let wrap = |v: i64, n: i64| {
+        if v < 0 {
+            v + n
+        } else if v >= n {
+            v - n
+        } else {
+            v
+        }
+    };
+    let rows: Vec<RowVote> = (0..h)
         .into_par_iter()
         .map(|y| {
-            (0..w)
-                .map(|x| {
-                    let mut sdf = vec![0.0f32; layers];
-                    let mut count = 0.0f32;
-                    let (mut col, mut wsum) = ([0.0f32; 3], 0.0f32);
-                    let (x, y) = (x as i64, y as i64);
-                    let (i0, i1) = (
-                        ((x - r).max(0) + s - 1) / s,
-                        ((x + r) / s).min(nnf.cols as i64 - 1),
-                    );
-                    let (j0, j1) = (
-                        ((y - r).max(0) + s - 1) / s,
-                        ((y + r) / s).min(nnf.rows as i64 - 1),
-                    );
-                    for j in j0..=j1 {
-                        for i in i0..=i1 {
-                            let k = (j * nnf.cols as i64 + i) as usize;
-                            let m = nnf.matches[k];
-                            let (qx, qy) = (i * s, j * s);
-                            let (dx, dy) = (x - qx, y - qy);
-                            let b = pb.bin(m.x as usize, m.y as usize, qx as usize, qy as usize);
-                            let e = pb.patch.table(b)[((dy + r) * side + dx + r) as usize];
-                            let sx =
-                                (m.x as i64 + e.2 as i64).rem_euclid(t.width() as i64) as usize;
-                            let sy =
-                                (m.y as i64 + e.3 as i64).rem_euclid(t.height() as i64) as usize;
-                            for (acc, l) in sdf.iter_mut().zip(&t.layers) {
-                                *acc += l.sdf.get(sx, sy);
-                            }
-                            count += 1.0;
-                            let wc = weights[k];
-                            let c = t.colour.get(sx, sy);
-                            for q in 0..3 {
-                                col[q] += wc * c[q];
-                            }
-                            wsum += wc;
+            let mut row = RowVote {
+                sdf: vec![0.0; w * layers],
+                count: vec![0.0; w],
+                colour: vec![[0.0; 3]; w],
+                weight: vec![0.0; w],
+            };
+            let y = y as i64;
+            let (j0, j1) = (
+                ((y - r).max(0) + s - 1) / s,
+                ((y + r) / s).min(nnf.rows as i64 - 1),
+            );
+            for j in j0..=j1 {
+                let dy = y - j * s;
+                for i in 0..nnf.cols as i64 {
+                    let k = (j * nnf.cols as i64 + i) as usize;
+                    let m = nnf.matches[k];
+                    let (wc, b) = per_centre[k];
+                    let table = pb.patch.table(b);
+                    let qx = i * s;
+                    let (x0, x1) = ((qx - r).max(0), (qx + r).min(w as i64 - 1));
+                    for x in x0..=x1 {
+                        let e = table[((dy + r) * side + x - qx + r) as usize];
+                        let sx = wrap(m.x as i64 + e.2 as i64, tw) as usize;
+                        let sy = wrap(m.y as i64 + e.3 as i64, th) as usize;
+                        let xu = x as usize;
+                        for (l, layer) in t.layers.iter().enumerate() {
+                            row.sdf[xu * layers + l] += layer.sdf.get(sx, sy);
                         }
-                    }
-                    if count > 0.0 {
-                        for v in &mut sdf {
-                            *v /= count;
+                        row.count[xu] += 1.0;
+                        let c = t.colour.get(sx, sy);
+                        for (acc, v) in row.colour[xu].iter_mut().zip(c) {
+                            *acc += wc * v;
                         }
+                        row.weight[xu] += wc;
                     }
-                    let col = if wsum > 0.0 {
-                        col.map(|c| c / wsum)
-                    } else {
-                        [1.0; 3]
-                    };
-                    (sdf, count, col)
-                })
-                .collect()
+                }
+            }
+            row
         })
         .collect();
     let mut sdf: Vec<(Grid<f32>, Grid<f32>)> = (0..layers)
@@ -444,13 +454,39 @@ fn vote(pb: &Problem, nnf: &Nnf, t: &Tile, w: usize, h: usize) -> Votes {
         .collect();
     let mut colour = Grid::new(w, h, [1.0f32; 3]);
     for (y, row) in rows.into_iter().enumerate() {
-        for (x, (v, count, c)) in row.into_iter().enumerate() {
-            for (m, (mean, cnt)) in sdf.iter_mut().enumerate() {
-                mean.set(x, y, v[m]);
-                cnt.set(x, y, count);
+        for x in 0..w {
+            let n = row.count[x];
+            for (l, (mean, cnt)) in sdf.iter_mut().enumerate() {
+                mean.set(
+                    x,
+                    y,
+                    if n > 0.0 {
+                        row.sdf[x * layers + l] / n
+                    } else {
+                        0.0
+                    },
+                );
+                cnt.set(x, y, n);
             }
-            colour.set(x, y, c);
+            let ws = row.weight[x];
+            colour.set(
+                x,
+                y,
+                if ws > 0.0 {
+                    row.colour[x].map(|c| c / ws)
+                } else {
+                    [1.0; 3]
+                },
+            );
         }
     }
     Votes { sdf, colour }
+}
+
+/// One row's vote sums.
+struct RowVote {
+    sdf: Vec<f32>,
+    count: Vec<f32>,
+    colour: Vec<[f32; 3]>,
+    weight: Vec<f32>,
 }

@@ -112,9 +112,10 @@ pub fn step(phi: &mut Grid<f32>, target: &Grid<f32>, weight: &Grid<f32>, ev: &Ev
     }
 }
 
-/// Replaces `phi` by the exact signed distance to its zero level (pixel
-/// units, negative inside); a field without a zero level keeps its sign
-/// and is clamped to the grid's diagonal.
+/// Replaces `phi` by the signed distance to its zero level (pixel units,
+/// negative inside): sub-pixel contours of `Φ`, exact distances to them
+/// within `sdf::BAND`, within half a pixel beyond. A field without a zero
+/// level keeps its sign, clamped to the grid's diagonal.
 pub fn reinitialize(phi: &mut Grid<f32>) {
     let mut segments = Vec::new();
     for c in contour::extract(phi) {
@@ -123,7 +124,6 @@ pub fn reinitialize(phi: &mut Grid<f32>) {
             segments.push(Line::new(c.points[i], c.points[(i + 1) % n]));
         }
     }
-    let inside = phi.map(|v| v < 0.0);
     if segments.is_empty() {
         let far = (phi.width() + phi.height()) as f32;
         for v in phi.data_mut() {
@@ -131,8 +131,8 @@ pub fn reinitialize(phi: &mut Grid<f32>) {
         }
         return;
     }
-    let sdf = Sdf::from_segments(&inside, &segments, Affine::IDENTITY);
-    *phi = sdf.dist;
+    let inside = phi.map(|v| v < 0.0);
+    *phi = Sdf::from_segments(&inside, &segments, Affine::IDENTITY).dist;
 }
 
 #[cfg(test)]

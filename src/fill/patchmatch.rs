@@ -140,7 +140,11 @@ pub fn angle_bin(beta: f32) -> usize {
 
 /// What a search compares: the periodic source and its direction angles,
 /// the target and its direction angles (radians, pixel axes).
-#[derive(Clone, Copy, Debug)]
+///
+/// The source is stored padded by its own wrap-around (a margin of
+/// `⌈r√2⌉ + 1` pixels), so a rotated patch is a gather at precomputed
+/// linear offsets with no per-pixel wrapping.
+#[derive(Clone, Debug)]
 pub struct Problem<'a> {
     /// Tile channels (wrapping).
     pub source: &'a Channels,
@@ -152,9 +156,54 @@ pub struct Problem<'a> {
     pub target_angle: &'a Grid<f32>,
     /// Patch geometry.
     pub patch: &'a Patch,
+    padded: Vec<f32>,
+    padded_width: usize,
+    margin: usize,
+    linear: Vec<Vec<isize>>,
 }
 
-impl Problem<'_> {
+impl<'a> Problem<'a> {
+    /// Sets up a search (pads the source, builds the gather offsets).
+    pub fn new(
+        source: &'a Channels,
+        source_angle: &'a Grid<f32>,
+        target: &'a Channels,
+        target_angle: &'a Grid<f32>,
+        patch: &'a Patch,
+    ) -> Problem<'a> {
+        let margin = (patch.radius as f64 * std::f64::consts::SQRT_2).ceil() as usize + 1;
+        let (w, h, d) = (source.width, source.height, source.depth);
+        let (pw, ph) = (w + 2 * margin, h + 2 * margin);
+        let mut padded = Vec::with_capacity(pw * ph * d);
+        for y in 0..ph {
+            let sy = (y + h * (margin / h + 1) - margin) % h;
+            for x in 0..pw {
+                let sx = (x + w * (margin / w + 1) - margin) % w;
+                padded.extend_from_slice(source.px(sx, sy));
+            }
+        }
+        let linear = (0..ANGLE_BINS)
+            .map(|b| {
+                patch
+                    .table(b)
+                    .iter()
+                    .map(|&(_, _, rx, ry)| (ry as isize * pw as isize + rx as isize) * d as isize)
+                    .collect()
+            })
+            .collect();
+        Problem {
+            source,
+            source_angle,
+            target,
+            target_angle,
+            patch,
+            padded,
+            padded_width: pw,
+            margin,
+            linear,
+        }
+    }
+
     /// The rotation bin between tile pixel `(px, py)` and target `(qx, qy)`.
     #[inline]
     pub fn bin(&self, px: usize, py: usize, qx: usize, qy: usize) -> usize {
@@ -215,16 +264,13 @@ impl Problem<'_> {
         py: usize,
         bound: f32,
     ) -> f32 {
-        let s = self.source;
-        let d = s.depth;
-        let table = self.patch.table(self.bin(px, py, qx, qy));
-        let (w, h) = (s.width as i32, s.height as i32);
+        let d = self.source.depth;
+        let offsets = &self.linear[self.bin(px, py, qx, qy)];
+        let base = (((py + self.margin) * self.padded_width + px + self.margin) * d) as isize;
         let mut sum = 0.0f32;
-        for (k, &(_, _, rx, ry)) in table.iter().enumerate() {
-            let x = (px as i32 + rx).rem_euclid(w) as usize;
-            let y = (py as i32 + ry).rem_euclid(h) as usize;
-            let sp = s.px(x, y);
-            let t = &tp[k * d..k * d + d];
+        for (t, &off) in tp.chunks_exact(d).zip(offsets) {
+            let i = (base + off) as usize;
+            let sp = &self.padded[i..i + d];
             for c in 0..d {
                 let e = sp[c] - t[c];
                 sum += e * e;
@@ -426,13 +472,7 @@ mod tests {
         let zero_s = Grid::new(32, 32, 0.0);
         let zero_t = Grid::new(w, h, 0.0);
         let patch = Patch::new(3);
-        let pb = Problem {
-            source: &src,
-            source_angle: &zero_s,
-            target: &tgt,
-            target_angle: &zero_t,
-            patch: &patch,
-        };
+        let pb = Problem::new(&src, &zero_s, &tgt, &zero_t, &patch);
         let mut nnf = random_nnf(w, h, 2, &src, 7);
         pb.refresh(&mut nnf);
         for round in 0..6 {
@@ -501,13 +541,7 @@ mod tests {
         let sa = Grid::new(24, 24, 0.0);
         let ta = Grid::new(w, h, -std::f32::consts::FRAC_PI_2);
         let patch = Patch::new(2);
-        let pb = Problem {
-            source: &src,
-            source_angle: &sa,
-            target: &tgt,
-            target_angle: &ta,
-            patch: &patch,
-        };
+        let pb = Problem::new(&src, &sa, &tgt, &ta, &patch);
         let bf = pb.brute_force(10, 10);
         assert_eq!((bf.x, bf.y, bf.cost), (7, 4, 0.0));
     }
