@@ -2,8 +2,9 @@
 //! from a 128×128 tile (the `knot` tile at 128 px), constant direction.
 //!
 //! Run: `cargo run --release --example fill_timing [TILE.svg] [SIDE]`;
-//! writes `/tmp/fill-timing.png` (the bottom layer's ink) and prints the
-//! median of five runs and the per-level energies.
+//! writes `/tmp/fill-tile-128.png` (the tile's colour, the input for the
+//! texture-synthesis comparison) and `/tmp/fill-timing.png` (the bottom
+//! layer's ink), and prints the median of five runs and the energies.
 
 use flourish::field::diffusion::constant_field;
 use flourish::fill::em::{synthesize, EmParams};
@@ -18,6 +19,12 @@ fn main() {
     });
     let side: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(512);
     let t = Tile::load(&tile, 128, SourceDirection::Constant([1.0, 0.0])).expect("tile");
+    // The tile as the comparison's input PNG (composite colour, 128×128).
+    let tile_png = image::RgbImage::from_fn(t.width() as u32, t.height() as u32, |x, y| {
+        let c = t.colour.get(x as usize, y as usize);
+        image::Rgb(c.map(|v| (v * 255.0).round().clamp(0.0, 255.0) as u8))
+    });
+    let _ = tile_png.save("/tmp/fill-tile-128.png");
     let dir = constant_field(side, side, [1.0, 0.0]);
     let params = EmParams::default();
     let mut times = Vec::new();

@@ -171,7 +171,7 @@ fn main() -> std::io::Result<()> {
     )?;
     write(
         &f.join("combed.svg"),
-        &sketch("  <rect x=\"10\" y=\"30\" width=\"180\" height=\"140\" rx=\"20\" fill=\"#ccc\"/>\n  <path d=\"M20 150C70 150 90 50 180 50\" fill=\"none\" stroke=\"#f00\" stroke-width=\"80\"/>\n"),
+        &sketch("  <rect x=\"10\" y=\"30\" width=\"180\" height=\"140\" rx=\"20\" fill=\"#ccc\"/>\n  <path d=\"M20 150C70 150 90 50 180 50\" fill=\"none\" stroke=\"#f00\" stroke-opacity=\"0.3\" stroke-width=\"80\"/>\n"),
     )?;
     write(
         &f.join("open-only.svg"),

@@ -96,6 +96,8 @@ pub struct Patch {
     /// Per angle bin, per offset: `(dx, dy, rx, ry)`, the target offset and
     /// its rotation rounded to pixels.
     tables: Vec<Vec<(i32, i32, i32, i32)>>,
+    /// Sine and cosine of each bin's angle.
+    sin_cos: Vec<(f32, f32)>,
 }
 
 impl Patch {
@@ -121,7 +123,14 @@ impl Patch {
                 t
             })
             .collect();
-        Patch { radius, tables }
+        let sin_cos = (0..ANGLE_BINS)
+            .map(|b| (b as f32 * std::f32::consts::TAU / ANGLE_BINS as f32).sin_cos())
+            .collect();
+        Patch {
+            radius,
+            tables,
+            sin_cos,
+        }
     }
 
     /// The offset table of angle bin `b`.
@@ -222,10 +231,8 @@ impl<'a> Problem<'a> {
         dx: i32,
         dy: i32,
     ) -> (usize, usize) {
-        let b = self.bin(px, py, qx, qy);
-        let a = b as f64 * std::f64::consts::TAU / ANGLE_BINS as f64;
-        let (s, c) = a.sin_cos();
-        let (fx, fy) = (dx as f64, dy as f64);
+        let (s, c) = self.patch.sin_cos[self.bin(px, py, qx, qy)];
+        let (fx, fy) = (dx as f32, dy as f32);
         let rx = (c * fx - s * fy).round() as i64;
         let ry = (s * fx + c * fy).round() as i64;
         self.wrap(px as i64 + rx, py as i64 + ry)
@@ -302,7 +309,10 @@ impl<'a> Problem<'a> {
     /// Costs must be current (see [`Problem::refresh`]).
     pub fn improve(&self, nnf: &mut Nnf, seed: u64, round: u64) {
         let (sw, sh) = (self.source.width, self.source.height);
-        let start = nnf.clone();
+        let start = Nnf {
+            matches: std::mem::take(&mut nnf.matches),
+            ..*nnf
+        };
         // Random search (CaTS Alg. 5, windows halving from the tile size).
         nnf.matches = (0..start.matches.len())
             .into_par_iter()
@@ -341,7 +351,10 @@ impl<'a> Problem<'a> {
             .collect();
         // Propagation by jump flooding (CaTS Alg. 6).
         for step in [4usize, 2, 1] {
-            let prev = nnf.clone();
+            let prev = Nnf {
+                matches: std::mem::take(&mut nnf.matches),
+                ..*nnf
+            };
             nnf.matches = (0..prev.matches.len())
                 .into_par_iter()
                 .map_init(Vec::new, |buf, k| {

@@ -9,9 +9,10 @@
 //! programming over the squared differences (a path from one side to the
 //! other, moving at most one pixel sideways per row).
 
-use super::patchmatch::Channels;
+use super::patchmatch::{angle_bin, Channels, ANGLE_BINS};
 use crate::pattern::rng;
 use crate::raster::Grid;
+use rayon::prelude::*;
 
 /// Quilting parameters, pixels.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -46,12 +47,28 @@ pub fn quilt(
     let step = b - ov;
     let mut map = Grid::new(width, height, (0u32, 0u32));
     let mut filled = Grid::new(width, height, false);
+    // Block offsets turned by each quantized angle (the M-step's bins).
+    let tables: Vec<Vec<(i64, i64)>> = (0..ANGLE_BINS)
+        .map(|k| {
+            let a = k as f32 * std::f32::consts::TAU / ANGLE_BINS as f32;
+            let (sn, cs) = a.sin_cos();
+            (0..b * b)
+                .map(|i| {
+                    let (dx, dy) = (
+                        (i % b) as f32 - (b / 2) as f32,
+                        (i / b) as f32 - (b / 2) as f32,
+                    );
+                    (
+                        (cs * dx - sn * dy).round() as i64,
+                        (sn * dx + cs * dy).round() as i64,
+                    )
+                })
+                .collect()
+        })
+        .collect();
     // Tile pixel for block offset (x, y) of a block centred on tile (sx, sy).
-    let rot = |sx: usize, sy: usize, x: usize, y: usize, beta: f32| -> (usize, usize) {
-        let (dx, dy) = (x as f32 - (b / 2) as f32, y as f32 - (b / 2) as f32);
-        let (sn, cs) = beta.sin_cos();
-        let rx = (cs * dx - sn * dy).round() as i64;
-        let ry = (sn * dx + cs * dy).round() as i64;
+    let rot = |sx: usize, sy: usize, x: usize, y: usize, bin: usize| -> (usize, usize) {
+        let (rx, ry) = tables[bin][y * b + x];
         (
             (sx as i64 + rx).rem_euclid(sw as i64) as usize,
             (sy as i64 + ry).rem_euclid(sh as i64) as usize,
@@ -65,7 +82,7 @@ pub fn quilt(
             let bw = b.min(width - bx);
             let bh = b.min(height - by);
             let ta = target_angle.get((bx + b / 2).min(width - 1), (by + b / 2).min(height - 1));
-            let beta = |sx: usize, sy: usize| source_angle.get(sx, sy) - ta;
+            let beta = |sx: usize, sy: usize| angle_bin(source_angle.get(sx, sy) - ta);
             // Overlap error of a candidate tile origin (sx, sy).
             let overlap_err = |sx: usize, sy: usize| -> f32 {
                 let be = beta(sx, sy);
@@ -87,10 +104,12 @@ pub fn quilt(
             // Every tile position when the tile is small, else a seeded sample.
             let cands: Vec<(usize, usize, f32)> = if sw * sh <= o.candidates {
                 (0..sw * sh)
+                    .into_par_iter()
                     .map(|i| (i % sw, i / sw, overlap_err(i % sw, i / sw)))
                     .collect()
             } else {
                 (0..o.candidates.max(1))
+                    .into_par_iter()
                     .map(|k| {
                         let sx = rng::index(&[o.seed, bi, k as u64, 0], sw);
                         let sy = rng::index(&[o.seed, bi, k as u64, 1], sh);
