@@ -140,6 +140,13 @@ impl Patch {
     }
 }
 
+/// Nearest integer, halves away from zero (a cast instead of `libm`'s
+/// `round`, which dominated the propagation step).
+#[inline]
+fn round(v: f32) -> i64 {
+    (v + 0.5f32.copysign(v)) as i64
+}
+
 /// The angle bin of `beta` radians.
 #[inline]
 pub fn angle_bin(beta: f32) -> usize {
@@ -233,8 +240,8 @@ impl<'a> Problem<'a> {
     ) -> (usize, usize) {
         let (s, c) = self.patch.sin_cos[self.bin(px, py, qx, qy)];
         let (fx, fy) = (dx as f32, dy as f32);
-        let rx = (c * fx - s * fy).round() as i64;
-        let ry = (s * fx + c * fy).round() as i64;
+        let rx = round(c * fx - s * fy);
+        let ry = round(s * fx + c * fy);
         self.wrap(px as i64 + rx, py as i64 + ry)
     }
 
@@ -250,12 +257,21 @@ impl<'a> Problem<'a> {
     pub fn target_patch(&self, qx: usize, qy: usize, out: &mut Vec<f32>) {
         out.clear();
         let t = self.target;
+        let d = t.depth;
         let r = self.patch.radius as i64;
+        let (x0, x1) = (qx as i64 - r, qx as i64 + r);
+        let inside_x = x0 >= 0 && x1 < t.width as i64;
         for dy in -r..=r {
-            for dx in -r..=r {
-                let x = (qx as i64 + dx).clamp(0, t.width as i64 - 1) as usize;
-                let y = (qy as i64 + dy).clamp(0, t.height as i64 - 1) as usize;
-                out.extend_from_slice(t.px(x, y));
+            let y = (qy as i64 + dy).clamp(0, t.height as i64 - 1) as usize;
+            if inside_x {
+                // One contiguous run of the row.
+                let a = (y * t.width + x0 as usize) * d;
+                out.extend_from_slice(&t.data[a..a + (2 * r as usize + 1) * d]);
+            } else {
+                for x in x0..=x1 {
+                    let x = x.clamp(0, t.width as i64 - 1) as usize;
+                    out.extend_from_slice(t.px(x, y));
+                }
             }
         }
     }

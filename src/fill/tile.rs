@@ -212,6 +212,28 @@ mod tests {
     use super::*;
 
     #[test]
+    fn etf_source_direction_runs_along_the_stripes() {
+        // Vertical ink stripes 4 px wide every 8 px: the signed ETF of the
+        // tile runs vertically at the stripes' edges.
+        let sdf = periodic_sdf(&Grid::from_fn(32, 32, |x, _| {
+            let u = (x % 8) as f32 + 0.5;
+            (u - 4.0).max(-u)
+        }));
+        let layers = vec![TileLayer {
+            color: Color::BLACK,
+            sdf,
+        }];
+        let t = Tile::assemble(layers, SourceDirection::Etf, 1.0);
+        for y in [3, 16, 29] {
+            for x in [4, 12, 20] {
+                let d = t.direction.get(x, y);
+                assert!(d[1].abs() > 0.9, "({x}, {y}): {d:?}");
+            }
+        }
+        assert!((t.ink_fraction(0) - 0.5).abs() < 0.01);
+    }
+
+    #[test]
     fn periodic_sdf_sees_across_the_seam() {
         // A vertical band at x in [0, 2) of a 16-wide tile: pixel 15 is
         // 1 px from the band's copy to its right, not 13.

@@ -317,6 +317,36 @@ mod tests {
     }
 
     #[test]
+    fn fill_style_keys_parse_and_are_checked() {
+        let ok = parse(
+            Path::new("s/style.toml"),
+            "kind = \"fill\"\ndirection = \"etf\"\npatch = 7\nlevels = 2\n[[exemplar]]\nfile = \"t.svg\"\n",
+        )
+        .unwrap();
+        assert_eq!(ok.direction, Some(DirectionToml::Named("etf".into())));
+        for (extra, key) in [
+            ("direction = [0.0, 0.0]", "direction"),
+            ("direction = \"north\"", "direction"),
+            ("patch = 8", "patch"),
+            ("levels = 9", "levels"),
+            ("iterations = 0", "iterations"),
+            ("alpha = 2.0", "alpha"),
+        ] {
+            let e = parse(
+                Path::new("s/style.toml"),
+                &format!("kind = \"fill\"\n{extra}\n[[exemplar]]\nfile = \"t.svg\"\n"),
+            )
+            .unwrap_err()
+            .to_string();
+            assert!(e.starts_with("s/style.toml: ") && e.contains(key), "{e}");
+        }
+        let e = parse(Path::new("s/style.toml"), "kind = \"fill\"\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("exemplar"), "{e}");
+    }
+
+    #[test]
     fn bad_values_name_file_and_key() {
         for (text, key) in [
             (
