@@ -294,3 +294,46 @@ fn golden_outputs() {
         check_golden(&format!("{name}-{style}.svg"), &svg);
     }
 }
+
+#[test]
+fn a_direction_file_combs_every_region() {
+    let dir = tempfile::tempdir().unwrap();
+    let strokes = write_sketch(
+        dir.path(),
+        "d.svg",
+        "<path d=\"M10 100H190\" fill=\"none\" stroke=\"#000\" stroke-width=\"60\"/>",
+    );
+    let sk = sketch::load(&sample("star")).unwrap();
+    let plain = fill_sketch(&opts("knot"), &sk).unwrap();
+    let combed = fill_sketch(
+        &FillOptions {
+            direction: Some(PathBuf::from(&strokes)),
+            ..opts("knot")
+        },
+        &sk,
+    )
+    .unwrap();
+    // Under the stroke the field is the stroke's direction (+x); the
+    // boundary flow there was not.
+    let r = &combed.regions[0].region;
+    let p = r.sdf.to_user.inverse() * Point::new(100.0, 100.0);
+    let d = r.direction.get(p.x as usize, p.y as usize);
+    assert!(d[0] > 0.95, "{d:?}");
+    assert_ne!(plain.to_document().to_svg(), combed.to_document().to_svg());
+    // A direction file without open paths is refused.
+    let bad = write_sketch(
+        dir.path(),
+        "bad.svg",
+        "<circle cx=\"9\" cy=\"9\" r=\"5\" fill=\"#000\"/>",
+    );
+    let e = fill_sketch(
+        &FillOptions {
+            direction: Some(PathBuf::from(&bad)),
+            ..opts("knot")
+        },
+        &sk,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("no open stroked path"), "{e}");
+}
