@@ -73,6 +73,18 @@ struct State {
 /// Synthesizes a `width`×`height` image from `tile` (finest level), whose
 /// texture follows `direction` (a unit vector per target pixel).
 pub fn synthesize(tile: &Tile, direction: &DirectionGrid, params: &EmParams) -> Synthesis {
+    synthesize_in(tile, direction, None, params)
+}
+
+/// [`synthesize`], searching and voting only the neighbourhoods that reach
+/// `mask` (the region, same size as `direction`); pixels no neighbourhood
+/// reaches keep their initial values. Energies count those neighbourhoods.
+pub fn synthesize_in(
+    tile: &Tile,
+    direction: &DirectionGrid,
+    mask: Option<&Grid<bool>>,
+    params: &EmParams,
+) -> Synthesis {
     let (width, height) = (direction.width(), direction.height());
     let levels = params.levels.max(1);
     let mut tiles = vec![tile.clone()];
@@ -95,6 +107,15 @@ pub fn synthesize(tile: &Tile, direction: &DirectionGrid, params: &EmParams) -> 
             d[1].atan2(d[0])
         });
         let source_angle = t.direction.map(|d| d[1].atan2(d[0]));
+        // Squared distance to the region at this level (any pixel of a
+        // block counts).
+        let near = mask.map(|m| {
+            let lm = Grid::from_fn(w, h, |x, y| {
+                (y * f..((y + 1) * f).min(height))
+                    .any(|yy| (x * f..((x + 1) * f).min(width)).any(|xx| m.get(xx, yy)))
+            });
+            crate::raster::edt::squared_edt(&lm)
+        });
         // Neighbourhood sizes: at the coarsest level a larger one first.
         let max_r = (t.width().min(t.height()) / 4).max(1);
         let mut radii = vec![params.radius.min(max_r).max(1)];
@@ -176,11 +197,23 @@ pub fn synthesize(tile: &Tile, direction: &DirectionGrid, params: &EmParams) -> 
             let (mut lambda, mut mu) = (0.2f32, 0.8f32);
             for it in 0..n {
                 let target = channels_of(&st.phi, &st.colour, params.alpha, clamp);
-                let pb = Problem::new(&source, &source_angle, &target, &target_angle, &patch);
+                let reach = (r as f32 * std::f32::consts::SQRT_2 + 1.0).powi(2);
+                let active: Option<Vec<bool>> = near.as_ref().map(|d| {
+                    (0..field.matches.len())
+                        .map(|k| {
+                            let (x, y) = field.centre(k);
+                            d.get(x.min(w - 1), y.min(h - 1)) <= reach
+                        })
+                        .collect()
+                });
+                let mut pb = Problem::new(&source, &source_angle, &target, &target_angle, &patch);
+                if let Some(a) = &active {
+                    pb = pb.with_active(a);
+                }
                 pb.refresh(&mut field);
                 let round = ((level * 8 + ri) * 64 + it) as u64;
                 pb.improve(&mut field, params.seed, round);
-                level_energy.push(interior_energy(&field, r, w, h));
+                level_energy.push(interior_energy(&field, r, w, h, active.as_deref()));
                 // E-step.
                 let votes = vote(&pb, &field, t, w, h);
                 // Eq. 4 sums the data force over the |s_x| overlapping
@@ -220,13 +253,15 @@ pub fn synthesize(tile: &Tile, direction: &DirectionGrid, params: &EmParams) -> 
 
 /// Eq. 6 over the neighbourhoods that lie inside the grid (those crossing
 /// its edge compare clamped pixels and are not neighbourhoods of `X`).
-pub fn interior_energy(nnf: &Nnf, r: usize, w: usize, h: usize) -> f64 {
+/// With `active`, only the flagged neighbourhoods count.
+pub fn interior_energy(nnf: &Nnf, r: usize, w: usize, h: usize, active: Option<&[bool]>) -> f64 {
     nnf.matches
         .iter()
         .enumerate()
         .filter(|(k, _)| {
             let (x, y) = nnf.centre(*k);
-            x >= r && y >= r && x + r < w && y + r < h
+            let on = active.map_or(true, |a| a.get(*k).copied().unwrap_or(true));
+            on && x >= r && y >= r && x + r < w && y + r < h
         })
         .map(|(_, m)| m.cost as f64)
         .sum()
@@ -424,6 +459,9 @@ fn vote(pb: &Problem, nnf: &Nnf, t: &Tile, w: usize, h: usize) -> Votes {
                 let dy = y - j * s;
                 for i in 0..nnf.cols as i64 {
                     let k = (j * nnf.cols as i64 + i) as usize;
+                    if !pb.is_active(k) {
+                        continue;
+                    }
                     let m = nnf.matches[k];
                     let (wc, b) = per_centre[k];
                     let table = pb.patch.table(b);

@@ -283,7 +283,7 @@ pub fn fill_sketch(opts: &FillOptions, sk: &Sketch) -> Result<FillOutput> {
             seed: crate::pattern::rng::hash(&[opts.seed, qi as u64]),
             ..st.params
         };
-        let syn = em::synthesize(&st.tile, &region.direction, &params);
+        let syn = em::synthesize_in(&st.tile, &region.direction, Some(&region.mask), &params);
         let mut layers = syn.layers;
         // Occlusion order: each layer extends under the layers above it.
         for k in (1..layers.len()).rev() {

@@ -176,6 +176,7 @@ pub struct Problem<'a> {
     padded_width: usize,
     margin: usize,
     linear: Vec<Vec<isize>>,
+    active: Option<&'a [bool]>,
 }
 
 impl<'a> Problem<'a> {
@@ -217,6 +218,23 @@ impl<'a> Problem<'a> {
             padded_width: pw,
             margin,
             linear,
+            active: None,
+        }
+    }
+
+    /// Restricts the search to the centres flagged in `active` (one flag
+    /// per centre of the field); the others keep their match and cost.
+    pub fn with_active(mut self, active: &'a [bool]) -> Problem<'a> {
+        self.active = Some(active);
+        self
+    }
+
+    /// Whether centre `k` is searched.
+    #[inline]
+    pub fn is_active(&self, k: usize) -> bool {
+        match self.active {
+            Some(a) => a.get(k).copied().unwrap_or(true),
+            None => true,
         }
     }
 
@@ -310,9 +328,12 @@ impl<'a> Problem<'a> {
         let costs: Vec<f32> = (0..nnf.matches.len())
             .into_par_iter()
             .map_init(Vec::new, |buf, k| {
+                let m = nnf.matches[k];
+                if !self.is_active(k) {
+                    return m.cost;
+                }
                 let (qx, qy) = nnf.centre(k);
                 self.target_patch(qx, qy, buf);
-                let m = nnf.matches[k];
                 self.distance(buf, qx, qy, m.x as usize, m.y as usize, f32::INFINITY)
             })
             .collect();
@@ -333,9 +354,12 @@ impl<'a> Problem<'a> {
         nnf.matches = (0..start.matches.len())
             .into_par_iter()
             .map_init(Vec::new, |buf, k| {
+                let mut best = start.matches[k];
+                if !self.is_active(k) {
+                    return best;
+                }
                 let (qx, qy) = start.centre(k);
                 self.target_patch(qx, qy, buf);
-                let mut best = start.matches[k];
                 let mut radius = sw.max(sh) as i64 / 2;
                 let mut i = 0u64;
                 while radius >= 1 {
@@ -374,9 +398,12 @@ impl<'a> Problem<'a> {
             nnf.matches = (0..prev.matches.len())
                 .into_par_iter()
                 .map_init(Vec::new, |buf, k| {
+                    let mut best = prev.matches[k];
+                    if !self.is_active(k) {
+                        return best;
+                    }
                     let (i, j) = (k % prev.cols, k / prev.cols);
                     let (qx, qy) = prev.centre(k);
-                    let mut best = prev.matches[k];
                     let mut gathered = false;
                     let neighbours = [
                         (i.checked_sub(step), Some(j)),
