@@ -80,6 +80,7 @@ fn ink_fraction_and_containment_per_region() {
             assert_eq!(out.regions.len(), 1);
             let r = &out.regions[0];
             let (f, t) = (r.ink_fraction(), r.tile_ink);
+            println!("{style}/{name}: ink {f:.3}, tile {t:.3}");
             assert!(
                 (f - t).abs() <= 0.15 * t,
                 "{style}/{name}: ink {f:.3}, tile {t:.3}"
@@ -369,9 +370,9 @@ fn a_png_tile_fills_a_region() {
     let r = &out.regions[0];
     assert_eq!(r.colors.len(), 1);
     let (f, t) = (r.ink_fraction(), r.tile_ink);
+    println!("png stripes: ink {f:.3}, tile {t:.3}");
     assert!((t - 12.0 / 32.0).abs() < 0.05, "{t}");
-    // Known shortfall: straight stripes bent into rings by the boundary
-    // flow lose ink where misaligned neighbourhoods are averaged (0.30 vs
-    // 0.375 today, −21 %); the shipped styles meet ±15 % (test above).
-    assert!((f - t).abs() <= 0.25 * t, "ink {f:.3}, tile {t:.3}");
+    // Straight stripes bent into rings by the boundary flow: without the
+    // histogram weight of the votes this lost a fifth of its ink.
+    assert!((f - t).abs() <= 0.15 * t, "ink {f:.3}, tile {t:.3}");
 }

@@ -8,8 +8,9 @@
 //! SDF channel moved by the level set with the mean matched SDF as data
 //! (Eq. 4) and curvature regularization (Eq. 5), weights `λ: 0.2 → 0.95`,
 //! `μ: 0.8 → 0.05` in steps of `0.75/N` (Alg. 1); the colour channels
-//! voted with the coherence weight of Brushables Eq. 7–8. The histogram
-//! weight of Eq. 7 is left out (weight 1): fills have few flat colours.
+//! voted with the coherence and histogram weights of Brushables Eq. 7–8
+//! (the histogram over each layer's ink and paper bins also weights the
+//! SDF votes, so the mean of Eq. 2 keeps the tile's ink fraction).
 //!
 //! The energy (Eq. 6) of the current image against the matches after each
 //! M-step is recorded per level, so its decrease can be checked.
@@ -215,7 +216,8 @@ pub fn synthesize_in(
                 pb.improve(&mut field, params.seed, round);
                 level_energy.push(interior_energy(&field, r, w, h, active.as_deref()));
                 // E-step.
-                let votes = vote(&pb, &field, t, w, h);
+                let hist = histogram_weights(&st.phi, t, near.as_ref());
+                let votes = vote(&pb, &field, t, &hist, w, h);
                 // Eq. 4 sums the data force over the |s_x| overlapping
                 // neighbourhoods; the level set uses their mean, so the
                 // curvature weight is divided by |s_x| to keep Eq. 5's balance.
@@ -380,6 +382,44 @@ struct Votes {
     colour: Grid<[f32; 3]>,
 }
 
+/// Steepness of the histogram weight.
+const HISTOGRAM_GAMMA: f32 = 4.0;
+
+/// The histogram weight `w_h` of Brushables Eq. 7 (Kopf et al. 2007) for
+/// the ink and paper bins of each layer: a bin over-represented in the
+/// current image relative to the tile (`H_s/H_e − 1 > 0`) has its
+/// candidates weighted `1/(1 + γ·(H_s/H_e − 1))`, so voting does not drift
+/// away from the tile's ink fraction. Counted over the region (`near` = 0)
+/// when there is one.
+fn histogram_weights(phi: &[Grid<f32>], t: &Tile, near: Option<&Grid<f32>>) -> Vec<[f32; 2]> {
+    phi.iter()
+        .enumerate()
+        .map(|(l, g)| {
+            let (mut ink, mut all) = (0usize, 0usize);
+            for (i, &v) in g.data().iter().enumerate() {
+                if near.map_or(true, |d| d.data().get(i).is_some_and(|&e| e == 0.0)) {
+                    all += 1;
+                    ink += usize::from(v < 0.0);
+                }
+            }
+            let hs_ink = if all > 0 {
+                ink as f32 / all as f32
+            } else {
+                0.0
+            };
+            let he_ink = t.ink_fraction(l) as f32;
+            let w = |hs: f32, he: f32| {
+                if he > 0.0 {
+                    1.0 / (1.0 + HISTOGRAM_GAMMA * (hs / he - 1.0).max(0.0))
+                } else {
+                    1.0
+                }
+            };
+            [w(hs_ink, he_ink), w(1.0 - hs_ink, 1.0 - he_ink)]
+        })
+        .collect()
+}
+
 /// Brushables Eq. 8: how well the rigid maps of neighbouring centres agree
 /// with centre `k`'s own (σ_c² = 2), averaged, plus a floor.
 fn coherence(pb: &Problem, nnf: &Nnf, k: usize) -> f32 {
@@ -415,7 +455,7 @@ fn coherence(pb: &Problem, nnf: &Nnf, k: usize) -> f32 {
 /// The E-step's gathering: every pixel collects the tile values its
 /// overlapping matched neighbourhoods put there. Rows are gathered in
 /// parallel, each scanning the centres whose patches cross it.
-fn vote(pb: &Problem, nnf: &Nnf, t: &Tile, w: usize, h: usize) -> Votes {
+fn vote(pb: &Problem, nnf: &Nnf, t: &Tile, hist: &[[f32; 2]], w: usize, h: usize) -> Votes {
     let per_centre: Vec<(f32, usize)> = (0..nnf.matches.len())
         .into_par_iter()
         .map(|k| {
@@ -446,6 +486,7 @@ fn vote(pb: &Problem, nnf: &Nnf, t: &Tile, w: usize, h: usize) -> Votes {
         .map(|y| {
             let mut row = RowVote {
                 sdf: vec![0.0; w * layers],
+                sdf_weight: vec![0.0; w * layers],
                 count: vec![0.0; w],
                 colour: vec![[0.0; 3]; w],
                 weight: vec![0.0; w],
@@ -472,15 +513,23 @@ fn vote(pb: &Problem, nnf: &Nnf, t: &Tile, w: usize, h: usize) -> Votes {
                         let sx = wrap(m.x as i64 + e.2 as i64, tw) as usize;
                         let sy = wrap(m.y as i64 + e.3 as i64, th) as usize;
                         let xu = x as usize;
+                        let mut wh0 = 1.0;
                         for (l, layer) in t.layers.iter().enumerate() {
-                            row.sdf[xu * layers + l] += layer.sdf.get(sx, sy);
+                            let v = layer.sdf.get(sx, sy);
+                            let wh = hist[l][usize::from(v >= 0.0)];
+                            if l == 0 {
+                                wh0 = wh;
+                            }
+                            row.sdf[xu * layers + l] += wh * v;
+                            row.sdf_weight[xu * layers + l] += wh;
                         }
                         row.count[xu] += 1.0;
                         let c = t.colour.get(sx, sy);
+                        let wv = wc * wh0;
                         for (acc, v) in row.colour[xu].iter_mut().zip(c) {
-                            *acc += wc * v;
+                            *acc += wv * v;
                         }
-                        row.weight[xu] += wc;
+                        row.weight[xu] += wv;
                     }
                 }
             }
@@ -498,8 +547,8 @@ fn vote(pb: &Problem, nnf: &Nnf, t: &Tile, w: usize, h: usize) -> Votes {
                 mean.set(
                     x,
                     y,
-                    if n > 0.0 {
-                        row.sdf[x * layers + l] / n
+                    if n > 0.0 && row.sdf_weight[x * layers + l] > 0.0 {
+                        row.sdf[x * layers + l] / row.sdf_weight[x * layers + l]
                     } else {
                         0.0
                     },
@@ -524,6 +573,7 @@ fn vote(pb: &Problem, nnf: &Nnf, t: &Tile, w: usize, h: usize) -> Votes {
 /// One row's vote sums.
 struct RowVote {
     sdf: Vec<f32>,
+    sdf_weight: Vec<f32>,
     count: Vec<f32>,
     colour: Vec<[f32; 3]>,
     weight: Vec<f32>,
