@@ -26,6 +26,13 @@ demo:
 	    $(BIN) pattern --style $$style $$s -o $(OUT)/pattern/$$n-$$style.svg --preview $(OUT)/pattern/$$n-$$style.png || exit 1; \
 	  done; \
 	done
+	mkdir -p $(OUT)/fill
+	for style in knot scales; do \
+	  for s in samples/fill/circle.svg samples/fill/star.svg samples/fill/letter.svg samples/fill/frame.svg samples/fill/combed.svg; do \
+	    n=$$(basename $$s .svg); \
+	    $(BIN) fill --style $$style $$s -o $(OUT)/fill/$$n-$$style.svg --preview $(OUT)/fill/$$n-$$style.png || exit 1; \
+	  done; \
+	done
 	@echo "demo outputs (SVG + preview PNG) are in $(OUT)/"
 
 # The whole test suite (heavy tests run optimized: see [profile.test]).
@@ -37,6 +44,7 @@ test: deps
 golden:
 	UPDATE_GOLDEN=1 $(CARGO) test --test trace golden
 	UPDATE_GOLDEN=1 $(CARGO) test --test pattern
+	UPDATE_GOLDEN=1 $(CARGO) test --test fill golden
 	git status --short golden/
 
 # Criterion benchmarks of every pipeline, then the side-by-side with potrace.

@@ -15,6 +15,7 @@ pub mod brush;
 pub mod diff;
 pub mod error;
 pub mod field;
+pub mod fill;
 pub mod io;
 pub mod pattern;
 pub mod raster;

@@ -2,6 +2,7 @@
 //! reports. Exit status: 0 success, 1 failure, 2 usage error.
 
 use clap::{Args, Parser, Subcommand};
+use flourish::fill::{self, FillOptions};
 use flourish::pattern::{self, PatternOptions};
 use flourish::raster::input::InputOptions;
 use flourish::trace::TraceOptions;
@@ -37,6 +38,8 @@ enum Command {
     Trace(TraceArgs),
     /// Arrange hand-drawn stroke elements along open paths and inside filled shapes.
     Pattern(PatternArgs),
+    /// Fill closed shapes with an art pattern synthesized from a tile.
+    Fill(FillArgs),
     /// Compare two SVGs by rendering; exit 1 when they differ beyond --tolerance.
     Diff(DiffArgs),
     /// Style libraries: analyse, report and draw diagnostics.
@@ -75,6 +78,37 @@ struct StyleCheckArgs {
     /// Exit 1 when there are warnings.
     #[arg(long)]
     strict: bool,
+}
+
+#[derive(Args)]
+struct FillArgs {
+    /// Sketch SVGs: filled shapes get the pattern; open paths inside them comb its direction.
+    #[arg(required = true, value_name = "SKETCH.svg")]
+    sketches: Vec<PathBuf>,
+    /// Fill style: a folder holding style.toml, or a name in --styles.
+    #[arg(long, default_value = "knot")]
+    style: String,
+    /// Folder of named styles (default: the styles shipped with flourish).
+    #[arg(long, value_name = "DIR")]
+    styles: Option<PathBuf>,
+    /// Output SVG (`-` for standard output); one sketch only.
+    #[arg(short = 'o', long = "output", value_name = "OUT.svg")]
+    output: Option<PathBuf>,
+    /// Output folder for a batch: NAME.svg per sketch.
+    #[arg(long, value_name = "DIR", conflicts_with = "output")]
+    out_dir: Option<PathBuf>,
+    /// Render the result to a PNG (with --out-dir: a folder for NAME.png).
+    #[arg(long, value_name = "PNG")]
+    preview: Option<PathBuf>,
+    /// Random seed: the same seed gives the same output.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// An SVG of open stroked paths that comb the pattern's direction in every region.
+    #[arg(long, value_name = "D.svg")]
+    direction: Option<PathBuf>,
+    /// Tile raster size in pixels (longest side), overriding the style's.
+    #[arg(long, value_name = "PX")]
+    resolution: Option<u32>,
 }
 
 #[derive(Args)]
@@ -202,6 +236,7 @@ fn run(cli: Cli) -> Result<(), Failure> {
     match cli.command {
         Command::Trace(args) => run_trace(args, cli.quiet),
         Command::Pattern(args) => run_pattern(args, cli.quiet, cli.verbose),
+        Command::Fill(args) => run_fill(args, cli.quiet, cli.verbose),
         Command::Diff(args) => run_diff(args, cli.quiet),
         Command::Style(StyleArgs {
             command: StyleCommand::Check(args),
@@ -263,6 +298,45 @@ fn run_pattern(args: PatternArgs, quiet: bool, verbose: bool) -> Result<(), Fail
         Ok(pattern::synthesize_sketch(&opts, &sk)?
             .to_document()
             .to_svg())
+    };
+    run_jobs(
+        &args.sketches,
+        args.output.as_deref(),
+        args.out_dir.as_deref(),
+        args.preview.as_deref(),
+        quiet,
+        &job,
+    )
+}
+
+fn run_fill(args: FillArgs, quiet: bool, verbose: bool) -> Result<(), Failure> {
+    if let Some(r) = args.resolution {
+        if !(8..=1024).contains(&r) {
+            return Err(Failure::Usage(format!(
+                "--resolution {r} is not in 8..=1024 px"
+            )));
+        }
+    }
+    let opts = FillOptions {
+        style: args.style.clone(),
+        styles_dir: args
+            .styles
+            .clone()
+            .unwrap_or_else(flourish::style::default_styles_dir),
+        seed: args.seed,
+        direction: args.direction.clone(),
+        resolution: args.resolution,
+        ..FillOptions::default()
+    };
+    let job = |sketch: &Path| -> Result<String, Error> {
+        let sk = flourish::sketch::load(sketch)?;
+        let out = fill::fill_sketch(&opts, &sk)?;
+        if verbose {
+            for note in sk.notes.iter().chain(&out.notes) {
+                eprintln!("flourish: {}: {note}", sketch.display());
+            }
+        }
+        Ok(out.to_document().to_svg())
     };
     run_jobs(
         &args.sketches,

@@ -89,6 +89,7 @@ pub struct StyleToml {
     pub exemplar: Vec<ExemplarToml>,
     /// Pattern: ε, the distance in the example's user units below which
     /// strokes are perceived as one element (Barla et al. §2.2).
+    /// Fill: sketch units per tile user unit (default 1).
     pub scale: Option<f64>,
     /// Pattern: neighbourhood size in rings of the neighbour graph used
     /// when matching (Barla et al. §3.1, 1..=6; default 2).
@@ -101,6 +102,27 @@ pub struct StyleToml {
     pub dimension: Option<u8>,
     /// Pattern: maximum Lloyd iterations for 2-D seeds (1..=1000; default 60).
     pub lloyd_iterations: Option<u32>,
+    /// Fill: the tile's own direction, `"etf"` (estimated from the tile,
+    /// Brushables §3.1) or a constant `[x, y]` in the tile's axes (y down).
+    pub direction: Option<DirectionToml>,
+    /// Fill: finest patch side in tile pixels (odd, 3..=33; default 9).
+    pub patch: Option<u32>,
+    /// Fill: pyramid levels (1..=5; default 3).
+    pub levels: Option<u32>,
+    /// Fill: EM iterations per level (1..=20; default 4).
+    pub iterations: Option<u32>,
+    /// Fill: colour weight α of the matching energy (0..=1; default 0.25).
+    pub alpha: Option<f64>,
+}
+
+/// A fill style's `direction`: a named estimate or a constant vector.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(untagged)]
+pub enum DirectionToml {
+    /// A constant direction `[x, y]`.
+    Vector([f64; 2]),
+    /// A named estimate: `"etf"`.
+    Named(String),
 }
 
 /// Parses `style.toml` text; `path` names the file in errors.
@@ -214,6 +236,9 @@ impl StyleToml {
                 }
             }
         }
+        if self.kind == StyleKind::Fill {
+            self.validate_fill(path)?;
+        }
         if self.kind == StyleKind::Pattern {
             if self.scale.is_none() {
                 return bad(
@@ -230,6 +255,55 @@ impl StyleToml {
                     ),
                 );
             }
+        }
+        Ok(())
+    }
+
+    /// The fill keys: ranges, and exactly one tile.
+    fn validate_fill(&self, path: &Path) -> Result<()> {
+        let bad = |key: &str, why: String| Err(Error::invalid(path, format!("{key}: {why}")));
+        match &self.direction {
+            Some(DirectionToml::Vector(v))
+                if !(v[0].is_finite() && v[1].is_finite() && v[0].hypot(v[1]) > 1e-9) =>
+            {
+                return bad("direction", format!("must be a non-zero vector, got {v:?}"));
+            }
+            Some(DirectionToml::Named(n)) if n != "etf" => {
+                return bad(
+                    "direction",
+                    format!("must be \"etf\" or [x, y], got \"{n}\""),
+                );
+            }
+            _ => {}
+        }
+        if let Some(p) = self.patch {
+            if !(3..=33).contains(&p) || p % 2 == 0 {
+                return bad("patch", format!("must be odd and within 3..33 px, got {p}"));
+            }
+        }
+        if let Some(l) = self.levels {
+            if !(1..=5).contains(&l) {
+                return bad("levels", format!("must be within 1..5, got {l}"));
+            }
+        }
+        if let Some(n) = self.iterations {
+            if !(1..=20).contains(&n) {
+                return bad("iterations", format!("must be within 1..20, got {n}"));
+            }
+        }
+        if let Some(a) = self.alpha {
+            if !(0.0..=1.0).contains(&a) {
+                return bad("alpha", format!("must be within 0..1, got {a}"));
+            }
+        }
+        if self.exemplar.len() != 1 {
+            return bad(
+                "exemplar",
+                format!(
+                    "a fill style takes exactly one tile (SVG or PNG), found {}",
+                    self.exemplar.len()
+                ),
+            );
         }
         Ok(())
     }
@@ -289,6 +363,36 @@ mod tests {
         .unwrap();
         assert_eq!(s.kind, StyleKind::Pattern);
         assert_eq!(s.scale, Some(12.0));
+    }
+
+    #[test]
+    fn fill_style_keys_parse_and_are_checked() {
+        let ok = parse(
+            Path::new("s/style.toml"),
+            "kind = \"fill\"\ndirection = \"etf\"\npatch = 7\nlevels = 2\n[[exemplar]]\nfile = \"t.svg\"\n",
+        )
+        .unwrap();
+        assert_eq!(ok.direction, Some(DirectionToml::Named("etf".into())));
+        for (extra, key) in [
+            ("direction = [0.0, 0.0]", "direction"),
+            ("direction = \"north\"", "direction"),
+            ("patch = 8", "patch"),
+            ("levels = 9", "levels"),
+            ("iterations = 0", "iterations"),
+            ("alpha = 2.0", "alpha"),
+        ] {
+            let e = parse(
+                Path::new("s/style.toml"),
+                &format!("kind = \"fill\"\n{extra}\n[[exemplar]]\nfile = \"t.svg\"\n"),
+            )
+            .unwrap_err()
+            .to_string();
+            assert!(e.starts_with("s/style.toml: ") && e.contains(key), "{e}");
+        }
+        let e = parse(Path::new("s/style.toml"), "kind = \"fill\"\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("exemplar"), "{e}");
     }
 
     #[test]

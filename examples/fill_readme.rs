@@ -1,0 +1,61 @@
+//! Draws the README's fill pictures: tile (3×3 repeats) | region | result,
+//! one PNG per shipped style, into `docs/fill-STYLE.png`.
+//!
+//! Run: `cargo run --release --example fill_readme`.
+
+use flourish::fill::{run, FillOptions};
+use flourish::render::render_tree;
+use std::path::Path;
+
+/// The inside of an SVG document: everything between its root tags.
+fn inner(svg: &str) -> &str {
+    let start = svg
+        .find("<svg")
+        .and_then(|i| svg[i..].find('>').map(|j| i + j + 1));
+    let end = svg.rfind("</svg>");
+    match (start, end) {
+        (Some(s), Some(e)) if s <= e => &svg[s..e],
+        _ => "",
+    }
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    for (style, sample) in [("knot", "circle"), ("scales", "combed")] {
+        let tile = std::fs::read_to_string(root.join(format!("styles/{style}/tile.svg")))?;
+        let sketch_path = root.join(format!("samples/fill/{sample}.svg"));
+        let sketch = std::fs::read_to_string(&sketch_path)?;
+        let opts = FillOptions {
+            style: style.into(),
+            ..FillOptions::default()
+        };
+        let result = run(&opts, &sketch_path)?.to_svg();
+        let mut tiles = String::new();
+        for j in 0..3 {
+            for i in 0..3 {
+                tiles += &format!(
+                    "<svg x=\"{}\" y=\"{}\" width=\"64\" height=\"64\" viewBox=\"0 0 64 64\">{}</svg>",
+                    i * 64,
+                    j * 64,
+                    inner(&tile)
+                );
+            }
+        }
+        let svg = format!(
+            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"640\" height=\"200\" viewBox=\"0 0 640 200\">\
+             <rect width=\"640\" height=\"200\" fill=\"#fff\"/>\
+             <svg x=\"4\" y=\"4\" width=\"192\" height=\"192\" viewBox=\"0 0 192 192\">{tiles}</svg>\
+             <rect x=\"4\" y=\"4\" width=\"64\" height=\"64\" fill=\"none\" stroke=\"#e04040\" stroke-width=\"1.5\"/>\
+             <svg x=\"220\" y=\"0\" width=\"200\" height=\"200\" viewBox=\"0 0 200 200\">{}</svg>\
+             <svg x=\"440\" y=\"0\" width=\"200\" height=\"200\" viewBox=\"0 0 200 200\">{}</svg></svg>",
+            inner(&sketch),
+            inner(&result)
+        );
+        let out = root.join(format!("docs/fill-{style}.png"));
+        let tree = flourish::io::parse_svg(&out, svg.as_bytes())?;
+        let pixmap = render_tree(&out, &tree, Some(640), None)?;
+        std::fs::write(&out, pixmap.encode_png()?)?;
+        println!("{}", out.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,580 @@
+//! The multiresolution EM loop of art-pattern-level-sets Alg. 1, with the
+//! direction-aware matching and coherence-weighted voting of Brushables.
+//!
+//! Per level, coarse to fine: initialize (quilting at the coarsest level,
+//! upsampling otherwise), then for each neighbourhood size and each of `N`
+//! iterations: **M-step** — PatchMatch over all channels (Eq. 6 distance,
+//! target patches rotated by the direction difference); **E-step** — every
+//! SDF channel moved by the level set with the mean matched SDF as data
+//! (Eq. 4) and curvature regularization (Eq. 5), weights `λ: 0.2 → 0.95`,
+//! `μ: 0.8 → 0.05` in steps of `0.75/N` (Alg. 1); the colour channels
+//! voted with the coherence and histogram weights of Brushables Eq. 7–8
+//! (the histogram over each layer's ink and paper bins also weights the
+//! SDF votes, so the mean of Eq. 2 keeps the tile's ink fraction).
+//!
+//! The energy (Eq. 6) of the current image against the matches after each
+//! M-step is recorded per level, so its decrease can be checked.
+
+use super::levelset::{self, Evolution};
+use super::patchmatch::{Channels, Match, Nnf, Patch, Problem};
+use super::quilt::{self, QuiltOptions};
+use super::tile::Tile;
+use crate::field::DirectionGrid;
+use crate::raster::Grid;
+use rayon::prelude::*;
+
+/// Parameters of the synthesis.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EmParams {
+    /// Colour weight `α` of Eq. 6 (SDF weight `1 − α`).
+    pub alpha: f32,
+    /// Finest patch radius `r` (patches are `(2r+1)²`).
+    pub radius: usize,
+    /// Pyramid levels (1 = finest only).
+    pub levels: usize,
+    /// EM iterations `N` per neighbourhood size (halved at the finest level).
+    pub iterations: usize,
+    /// Level-set time steps per E-step (the paper uses 5).
+    pub steps: usize,
+    /// Seed of every random choice.
+    pub seed: u64,
+}
+
+impl Default for EmParams {
+    fn default() -> Self {
+        EmParams {
+            alpha: 0.25,
+            radius: 4,
+            levels: 3,
+            iterations: 4,
+            steps: 5,
+            seed: 0,
+        }
+    }
+}
+
+/// The synthesized image at the finest level.
+#[derive(Clone, Debug)]
+pub struct Synthesis {
+    /// One SDF per tile layer, target pixels, negative inside.
+    pub layers: Vec<Grid<f32>>,
+    /// Voted colour (0..1 RGB).
+    pub colour: Grid<[f32; 3]>,
+    /// Eq. 6 energy after each M-step ([`interior_energy`]), per level
+    /// (coarse first), per neighbourhood size and iteration in order.
+    pub energy: Vec<Vec<f64>>,
+}
+
+/// The image being synthesized at one level.
+struct State {
+    phi: Vec<Grid<f32>>,
+    colour: Grid<[f32; 3]>,
+}
+
+/// Synthesizes a `width`×`height` image from `tile` (finest level), whose
+/// texture follows `direction` (a unit vector per target pixel).
+pub fn synthesize(tile: &Tile, direction: &DirectionGrid, params: &EmParams) -> Synthesis {
+    synthesize_in(tile, direction, None, params)
+}
+
+/// [`synthesize`], searching and voting only the neighbourhoods that reach
+/// `mask` (the region, same size as `direction`); pixels no neighbourhood
+/// reaches keep their initial values. Energies count those neighbourhoods.
+pub fn synthesize_in(
+    tile: &Tile,
+    direction: &DirectionGrid,
+    mask: Option<&Grid<bool>>,
+    params: &EmParams,
+) -> Synthesis {
+    let (width, height) = (direction.width(), direction.height());
+    let levels = params.levels.max(1);
+    let mut tiles = vec![tile.clone()];
+    for _ in 1..levels {
+        let t = tiles[tiles.len() - 1].half();
+        tiles.push(t);
+    }
+    let mut state: Option<State> = None;
+    let mut nnf: Option<Nnf> = None;
+    let mut energy = Vec::new();
+    for level in (0..levels).rev() {
+        let t = &tiles[level];
+        let f = 1usize << level;
+        let (w, h) = (width.div_ceil(f).max(1), height.div_ceil(f).max(1));
+        let target_angle = Grid::from_fn(w, h, |x, y| {
+            let d = direction.get(
+                (x * f + f / 2).min(width - 1),
+                (y * f + f / 2).min(height - 1),
+            );
+            d[1].atan2(d[0])
+        });
+        let source_angle = t.direction.map(|d| d[1].atan2(d[0]));
+        // Squared distance to the region at this level (any pixel of a
+        // block counts).
+        let near = mask.map(|m| {
+            let lm = Grid::from_fn(w, h, |x, y| {
+                (y * f..((y + 1) * f).min(height))
+                    .any(|yy| (x * f..((x + 1) * f).min(width)).any(|xx| m.get(xx, yy)))
+            });
+            crate::raster::edt::squared_edt(&lm)
+        });
+        // Neighbourhood sizes: at the coarsest level a larger one first.
+        let max_r = (t.width().min(t.height()) / 4).max(1);
+        let mut radii = vec![params.radius.min(max_r).max(1)];
+        if level + 1 == levels && levels > 1 && 2 * radii[0] <= max_r {
+            radii.insert(0, 2 * radii[0]);
+        }
+        let clamp = (params.radius as f32 + 1.0).max(2.0);
+        let source = channels_of(
+            &t.layers.iter().map(|l| l.sdf.clone()).collect::<Vec<_>>(),
+            &t.colour,
+            params.alpha,
+            clamp,
+        );
+        let mut st = match state.take() {
+            None => {
+                // Quilting with blocks of two patches.
+                let block = (4 * radii[0] + 2).min(t.width().min(t.height()));
+                let map = quilt::quilt(
+                    &source,
+                    &source_angle,
+                    &target_angle,
+                    &QuiltOptions {
+                        block,
+                        overlap: (block / 4).max(1),
+                        candidates: 4096,
+                        seed: params.seed,
+                    },
+                );
+                let phi = t
+                    .layers
+                    .iter()
+                    .map(|l| {
+                        Grid::from_fn(w, h, |x, y| {
+                            let (sx, sy) = map.get(x, y);
+                            l.sdf.get(sx as usize, sy as usize)
+                        })
+                    })
+                    .collect();
+                let colour = Grid::from_fn(w, h, |x, y| {
+                    let (sx, sy) = map.get(x, y);
+                    t.colour.get(sx as usize, sy as usize)
+                });
+                let spacing = spacing_of(radii[0]);
+                let (cols, rows) = Nnf::shape(w, h, spacing);
+                let matches = (0..cols * rows)
+                    .map(|k| {
+                        let (sx, sy) = map.get(
+                            ((k % cols) * spacing).min(w - 1),
+                            ((k / cols) * spacing).min(h - 1),
+                        );
+                        Match {
+                            x: sx,
+                            y: sy,
+                            cost: f32::INFINITY,
+                        }
+                    })
+                    .collect();
+                nnf = Some(Nnf {
+                    cols,
+                    rows,
+                    spacing,
+                    matches,
+                });
+                State { phi, colour }
+            }
+            Some(prev) => upsample(&prev, w, h),
+        };
+        let mut level_energy = Vec::new();
+        for (ri, &r) in radii.iter().enumerate() {
+            let patch = Patch::new(r);
+            let spacing = spacing_of(r);
+            let mut field = resample_nnf(nnf.take(), w, h, spacing, t);
+            let n = if level == 0 && levels > 1 {
+                params.iterations.div_ceil(2)
+            } else {
+                params.iterations
+            }
+            .max(1);
+            let (mut lambda, mut mu) = (0.2f32, 0.8f32);
+            for it in 0..n {
+                let target = channels_of(&st.phi, &st.colour, params.alpha, clamp);
+                let reach = (r as f32 * std::f32::consts::SQRT_2 + 1.0).powi(2);
+                let active: Option<Vec<bool>> = near.as_ref().map(|d| {
+                    (0..field.matches.len())
+                        .map(|k| {
+                            let (x, y) = field.centre(k);
+                            d.get(x.min(w - 1), y.min(h - 1)) <= reach
+                        })
+                        .collect()
+                });
+                let mut pb = Problem::new(&source, &source_angle, &target, &target_angle, &patch);
+                if let Some(a) = &active {
+                    pb = pb.with_active(a);
+                }
+                pb.refresh(&mut field);
+                let round = ((level * 8 + ri) * 64 + it) as u64;
+                pb.improve(&mut field, params.seed, round);
+                level_energy.push(interior_energy(&field, r, w, h, active.as_deref()));
+                // E-step.
+                let hist = histogram_weights(&st.phi, t, near.as_ref());
+                let votes = vote(&pb, &field, t, &hist, w, h);
+                // Eq. 4 sums the data force over the |s_x| overlapping
+                // neighbourhoods; the level set uses their mean, so the
+                // curvature weight is divided by |s_x| to keep Eq. 5's balance.
+                let overlap = ((2 * r + 1) as f32 / spacing as f32).powi(2);
+                let mu_level = mu / overlap;
+                let ev = Evolution {
+                    lambda,
+                    mu: mu_level,
+                    dt: 0.2,
+                    steps: params.steps,
+                    band: r as f32 + 2.0,
+                };
+                for (phi, (mean, count)) in st.phi.iter_mut().zip(&votes.sdf) {
+                    levelset::evolve(phi, mean, count, &ev);
+                }
+                st.colour = votes.colour;
+                lambda += 0.75 / n as f32;
+                mu -= 0.75 / n as f32;
+            }
+            nnf = Some(field);
+        }
+        energy.push(level_energy);
+        state = Some(st);
+    }
+    let st = state.unwrap_or_else(|| State {
+        phi: Vec::new(),
+        colour: Grid::new(width, height, [1.0; 3]),
+    });
+    Synthesis {
+        layers: st.phi,
+        colour: st.colour,
+        energy,
+    }
+}
+
+/// Eq. 6 over the neighbourhoods that lie inside the grid (those crossing
+/// its edge compare clamped pixels and are not neighbourhoods of `X`).
+/// With `active`, only the flagged neighbourhoods count.
+pub fn interior_energy(nnf: &Nnf, r: usize, w: usize, h: usize, active: Option<&[bool]>) -> f64 {
+    nnf.matches
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| {
+            let (x, y) = nnf.centre(*k);
+            let on = active.map_or(true, |a| a.get(*k).copied().unwrap_or(true));
+            on && x >= r && y >= r && x + r < w && y + r < h
+        })
+        .map(|(_, m)| m.cost as f64)
+        .sum()
+}
+
+/// Centre spacing `w/4` of art-pattern-level-sets §2 (at least 1).
+fn spacing_of(r: usize) -> usize {
+    ((2 * r + 1) / 4).max(1)
+}
+
+/// The weighted channel image: `√(1−α)·clamp(Φ/K)` per layer, then
+/// `√α·rgb`, so a plain SSD is the Eq. 6 energy.
+pub fn channels_of(phi: &[Grid<f32>], colour: &Grid<[f32; 3]>, alpha: f32, clamp: f32) -> Channels {
+    let (w, h) = (colour.width(), colour.height());
+    let (wd, wa) = ((1.0 - alpha).max(0.0).sqrt(), alpha.max(0.0).sqrt());
+    let depth = phi.len() + 3;
+    let mut data = Vec::with_capacity(w * h * depth);
+    for y in 0..h {
+        for x in 0..w {
+            for p in phi {
+                data.push(wd * p.get(x, y).clamp(-clamp, clamp) / clamp);
+            }
+            data.extend(colour.get(x, y).map(|c| wa * c));
+        }
+    }
+    Channels {
+        width: w,
+        height: h,
+        depth,
+        data,
+    }
+}
+
+/// The previous field brought to a new spacing or resolution: each new
+/// centre takes the match of the nearest old centre (scaled by 2 across a
+/// level, CaTS Alg. 2) shifted by the offset between them.
+fn resample_nnf(old: Option<Nnf>, w: usize, h: usize, spacing: usize, t: &Tile) -> Nnf {
+    let (cols, rows) = Nnf::shape(w, h, spacing);
+    let (tw, th) = (t.width() as i64, t.height() as i64);
+    let matches = match &old {
+        None => vec![
+            Match {
+                x: 0,
+                y: 0,
+                cost: f32::INFINITY
+            };
+            cols * rows
+        ],
+        Some(o) => {
+            // Old target extent in pixels decides the scale factor.
+            let old_w = (o.cols - 1) * o.spacing + 1;
+            let scale = if old_w * 2 <= w + 2 * o.spacing { 2 } else { 1 };
+            (0..cols * rows)
+                .map(|k| {
+                    let (qx, qy) = ((k % cols) * spacing, (k / cols) * spacing);
+                    let (cx, cy) = (qx / scale, qy / scale);
+                    let i = ((cx + o.spacing / 2) / o.spacing).min(o.cols - 1);
+                    let j = ((cy + o.spacing / 2) / o.spacing).min(o.rows - 1);
+                    let m = o.matches[j * o.cols + i];
+                    let ox = qx as i64 - (i * o.spacing * scale) as i64;
+                    let oy = qy as i64 - (j * o.spacing * scale) as i64;
+                    Match {
+                        x: ((m.x as i64 * scale as i64 + ox).rem_euclid(tw)) as u32,
+                        y: ((m.y as i64 * scale as i64 + oy).rem_euclid(th)) as u32,
+                        cost: f32::INFINITY,
+                    }
+                })
+                .collect()
+        }
+    };
+    Nnf {
+        cols,
+        rows,
+        spacing,
+        matches,
+    }
+}
+
+/// Bilinear upsampling to the next level: distances doubled (pixel unit
+/// halves), colours interpolated.
+fn upsample(prev: &State, w: usize, h: usize) -> State {
+    let (pw, ph) = (prev.colour.width(), prev.colour.height());
+    let pos = |x: usize, y: usize| {
+        (
+            (x as f64 + 0.5) * pw as f64 / w as f64,
+            (y as f64 + 0.5) * ph as f64 / h as f64,
+        )
+    };
+    let phi = prev
+        .phi
+        .iter()
+        .map(|g| {
+            Grid::from_fn(w, h, |x, y| {
+                let (u, v) = pos(x, y);
+                2.0 * g.sample(u, v)
+            })
+        })
+        .collect();
+    let chans: Vec<Grid<f32>> = (0..3).map(|k| prev.colour.map(|c| c[k])).collect();
+    let colour = Grid::from_fn(w, h, |x, y| {
+        let (u, v) = pos(x, y);
+        [
+            chans[0].sample(u, v),
+            chans[1].sample(u, v),
+            chans[2].sample(u, v),
+        ]
+    });
+    State { phi, colour }
+}
+
+/// What the matched neighbourhoods say about each pixel.
+struct Votes {
+    /// Per layer: mean matched SDF (tile px ≡ target px) and count.
+    sdf: Vec<(Grid<f32>, Grid<f32>)>,
+    /// Coherence-weighted colour (Brushables Eq. 7).
+    colour: Grid<[f32; 3]>,
+}
+
+/// Steepness of the histogram weight.
+const HISTOGRAM_GAMMA: f32 = 4.0;
+
+/// The histogram weight `w_h` of Brushables Eq. 7 (Kopf et al. 2007) for
+/// the ink and paper bins of each layer: a bin over-represented in the
+/// current image relative to the tile (`H_s/H_e − 1 > 0`) has its
+/// candidates weighted `1/(1 + γ·(H_s/H_e − 1))`, so voting does not drift
+/// away from the tile's ink fraction. Counted over the region (`near` = 0)
+/// when there is one.
+fn histogram_weights(phi: &[Grid<f32>], t: &Tile, near: Option<&Grid<f32>>) -> Vec<[f32; 2]> {
+    phi.iter()
+        .enumerate()
+        .map(|(l, g)| {
+            let (mut ink, mut all) = (0usize, 0usize);
+            for (i, &v) in g.data().iter().enumerate() {
+                if near.map_or(true, |d| d.data().get(i).is_some_and(|&e| e == 0.0)) {
+                    all += 1;
+                    ink += usize::from(v < 0.0);
+                }
+            }
+            let hs_ink = if all > 0 {
+                ink as f32 / all as f32
+            } else {
+                0.0
+            };
+            let he_ink = t.ink_fraction(l) as f32;
+            let w = |hs: f32, he: f32| {
+                if he > 0.0 {
+                    1.0 / (1.0 + HISTOGRAM_GAMMA * (hs / he - 1.0).max(0.0))
+                } else {
+                    1.0
+                }
+            };
+            [w(hs_ink, he_ink), w(1.0 - hs_ink, 1.0 - he_ink)]
+        })
+        .collect()
+}
+
+/// Brushables Eq. 8: how well the rigid maps of neighbouring centres agree
+/// with centre `k`'s own (σ_c² = 2), averaged, plus a floor.
+fn coherence(pb: &Problem, nnf: &Nnf, k: usize) -> f32 {
+    let r = pb.patch.radius;
+    let (qx, qy) = nnf.centre(k);
+    let m = nnf.matches[k];
+    let (tw, th) = (pb.source.width as i64, pb.source.height as i64);
+    let (ci, cj) = (k % nnf.cols, k / nnf.cols);
+    let reach = (r / nnf.spacing).max(1);
+    let (mut sum, mut n) = (0.0f32, 0u32);
+    for j in cj.saturating_sub(reach)..=(cj + reach).min(nnf.rows - 1) {
+        for i in ci.saturating_sub(reach)..=(ci + reach).min(nnf.cols - 1) {
+            if (i, j) == (ci, cj) {
+                continue;
+            }
+            let o = nnf.matches[j * nnf.cols + i];
+            let (dx, dy) = (
+                (i * nnf.spacing) as i32 - qx as i32,
+                (j * nnf.spacing) as i32 - qy as i32,
+            );
+            let (px, py) = pb.map(qx, qy, m.x as usize, m.y as usize, dx, dy);
+            // Torus distance between the two images of the neighbour.
+            let ex = (px as i64 - o.x as i64).rem_euclid(tw);
+            let ey = (py as i64 - o.y as i64).rem_euclid(th);
+            let (ex, ey) = (ex.min(tw - ex) as f32, ey.min(th - ey) as f32);
+            sum += (-(ex * ex + ey * ey) / (2.0 * 2.0)).exp();
+            n += 1;
+        }
+    }
+    1e-3 + if n > 0 { sum / n as f32 } else { 1.0 }
+}
+
+/// The E-step's gathering: every pixel collects the tile values its
+/// overlapping matched neighbourhoods put there. Rows are gathered in
+/// parallel, each scanning the centres whose patches cross it.
+fn vote(pb: &Problem, nnf: &Nnf, t: &Tile, hist: &[[f32; 2]], w: usize, h: usize) -> Votes {
+    let per_centre: Vec<(f32, usize)> = (0..nnf.matches.len())
+        .into_par_iter()
+        .map(|k| {
+            let (qx, qy) = nnf.centre(k);
+            let m = nnf.matches[k];
+            (
+                coherence(pb, nnf, k),
+                pb.bin(m.x as usize, m.y as usize, qx, qy),
+            )
+        })
+        .collect();
+    let r = pb.patch.radius as i64;
+    let s = nnf.spacing as i64;
+    let side = 2 * r + 1;
+    let layers = t.layers.len();
+    let (tw, th) = (t.width() as i64, t.height() as i64);
+    let wrap = |v: i64, n: i64| {
+        if v < 0 {
+            v + n
+        } else if v >= n {
+            v - n
+        } else {
+            v
+        }
+    };
+    let rows: Vec<RowVote> = (0..h)
+        .into_par_iter()
+        .map(|y| {
+            let mut row = RowVote {
+                sdf: vec![0.0; w * layers],
+                sdf_weight: vec![0.0; w * layers],
+                count: vec![0.0; w],
+                colour: vec![[0.0; 3]; w],
+                weight: vec![0.0; w],
+            };
+            let y = y as i64;
+            let (j0, j1) = (
+                ((y - r).max(0) + s - 1) / s,
+                ((y + r) / s).min(nnf.rows as i64 - 1),
+            );
+            for j in j0..=j1 {
+                let dy = y - j * s;
+                for i in 0..nnf.cols as i64 {
+                    let k = (j * nnf.cols as i64 + i) as usize;
+                    if !pb.is_active(k) {
+                        continue;
+                    }
+                    let m = nnf.matches[k];
+                    let (wc, b) = per_centre[k];
+                    let table = pb.patch.table(b);
+                    let qx = i * s;
+                    let (x0, x1) = ((qx - r).max(0), (qx + r).min(w as i64 - 1));
+                    for x in x0..=x1 {
+                        let e = table[((dy + r) * side + x - qx + r) as usize];
+                        let sx = wrap(m.x as i64 + e.2 as i64, tw) as usize;
+                        let sy = wrap(m.y as i64 + e.3 as i64, th) as usize;
+                        let xu = x as usize;
+                        let mut wh0 = 1.0;
+                        for (l, layer) in t.layers.iter().enumerate() {
+                            let v = layer.sdf.get(sx, sy);
+                            let wh = hist[l][usize::from(v >= 0.0)];
+                            if l == 0 {
+                                wh0 = wh;
+                            }
+                            row.sdf[xu * layers + l] += wh * v;
+                            row.sdf_weight[xu * layers + l] += wh;
+                        }
+                        row.count[xu] += 1.0;
+                        let c = t.colour.get(sx, sy);
+                        let wv = wc * wh0;
+                        for (acc, v) in row.colour[xu].iter_mut().zip(c) {
+                            *acc += wv * v;
+                        }
+                        row.weight[xu] += wv;
+                    }
+                }
+            }
+            row
+        })
+        .collect();
+    let mut sdf: Vec<(Grid<f32>, Grid<f32>)> = (0..layers)
+        .map(|_| (Grid::new(w, h, 0.0), Grid::new(w, h, 0.0)))
+        .collect();
+    let mut colour = Grid::new(w, h, [1.0f32; 3]);
+    for (y, row) in rows.into_iter().enumerate() {
+        for x in 0..w {
+            let n = row.count[x];
+            for (l, (mean, cnt)) in sdf.iter_mut().enumerate() {
+                mean.set(
+                    x,
+                    y,
+                    if n > 0.0 && row.sdf_weight[x * layers + l] > 0.0 {
+                        row.sdf[x * layers + l] / row.sdf_weight[x * layers + l]
+                    } else {
+                        0.0
+                    },
+                );
+                cnt.set(x, y, n);
+            }
+            let ws = row.weight[x];
+            colour.set(
+                x,
+                y,
+                if ws > 0.0 {
+                    row.colour[x].map(|c| c / ws)
+                } else {
+                    [1.0; 3]
+                },
+            );
+        }
+    }
+    Votes { sdf, colour }
+}
+
+/// One row's vote sums.
+struct RowVote {
+    sdf: Vec<f32>,
+    sdf_weight: Vec<f32>,
+    count: Vec<f32>,
+    colour: Vec<[f32; 3]>,
+    weight: Vec<f32>,
+}

@@ -1,0 +1,604 @@
+//! Rotated-patch PatchMatch: for each target neighbourhood, the most similar
+//! neighbourhood of the (periodic) tile.
+//!
+//! * **Distance** — the sum of squared differences over all channels of a
+//!   `(2r+1)²` patch (art-pattern-level-sets Eq. 6 when the channels are
+//!   pre-weighted by √α and √(1−α)), with the target patch rotated by the
+//!   direction difference `β = θ_s(p) − θ_t(q)` (Brushables Eq. 5): target
+//!   offset `o` is compared with source offset `R(β) o`. Angles are
+//!   quantized to [`ANGLE_BINS`] and the rotated offsets rounded to whole
+//!   pixels (tables built once), so a comparison is a plain gather.
+//! * **Search** (CaTS §4.1.2) — random search in windows halving from the
+//!   tile size around the current match, then propagation by jump flooding
+//!   with steps {4, 2, 1} (neighbour `n`'s match `p_n` proposes
+//!   `p_n + R(β_n)(q − n)`, the rigid map of Brushables Fig. 8).
+//!
+//! Every pass reads the previous field and writes a new one (Jacobi
+//! order), and random numbers are hashes of (seed, pass, position), so the
+//! result does not depend on the number of threads.
+
+use crate::pattern::rng;
+use crate::raster::Grid;
+use rayon::prelude::*;
+
+/// Number of quantized rotation angles.
+pub const ANGLE_BINS: usize = 32;
+
+/// A multi-channel image, channels interleaved per pixel.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Channels {
+    /// Width, pixels.
+    pub width: usize,
+    /// Height, pixels.
+    pub height: usize,
+    /// Channels per pixel.
+    pub depth: usize,
+    /// `width · height · depth` values, row-major.
+    pub data: Vec<f32>,
+}
+
+impl Channels {
+    /// The channel values of pixel `(x, y)`.
+    #[inline]
+    pub fn px(&self, x: usize, y: usize) -> &[f32] {
+        let i = (y * self.width + x) * self.depth;
+        &self.data[i..i + self.depth]
+    }
+}
+
+/// One match: a tile pixel and the patch distance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Match {
+    /// Tile x, pixels.
+    pub x: u32,
+    /// Tile y, pixels.
+    pub y: u32,
+    /// Patch distance (weighted SSD).
+    pub cost: f32,
+}
+
+/// The nearest-neighbour field over the patch centres `S_X`: target pixels
+/// `(i·spacing, j·spacing)` (art-pattern-level-sets §2 evaluates the energy
+/// on neighbourhoods `w/4` apart).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Nnf {
+    /// Centres per row.
+    pub cols: usize,
+    /// Rows of centres.
+    pub rows: usize,
+    /// Distance between centres, pixels.
+    pub spacing: usize,
+    /// Matches, row-major.
+    pub matches: Vec<Match>,
+}
+
+impl Nnf {
+    /// The target pixel of centre `k`.
+    #[inline]
+    pub fn centre(&self, k: usize) -> (usize, usize) {
+        (
+            (k % self.cols) * self.spacing,
+            (k / self.cols) * self.spacing,
+        )
+    }
+
+    /// Centres covering a `width`×`height` target at `spacing`.
+    pub fn shape(width: usize, height: usize, spacing: usize) -> (usize, usize) {
+        ((width - 1) / spacing + 1, (height - 1) / spacing + 1)
+    }
+}
+
+/// Patch geometry: radius and the rotated offset tables.
+#[derive(Clone, Debug)]
+pub struct Patch {
+    /// Radius `r`; patches are `(2r+1)²`.
+    pub radius: usize,
+    /// Per angle bin, per offset: `(dx, dy, rx, ry)`, the target offset and
+    /// its rotation rounded to pixels.
+    tables: Vec<Vec<(i32, i32, i32, i32)>>,
+    /// Sine and cosine of each bin's angle.
+    sin_cos: Vec<(f32, f32)>,
+}
+
+impl Patch {
+    /// Tables for radius `r`.
+    pub fn new(radius: usize) -> Patch {
+        let r = radius as i32;
+        let tables = (0..ANGLE_BINS)
+            .map(|b| {
+                let a = b as f64 * std::f64::consts::TAU / ANGLE_BINS as f64;
+                let (s, c) = a.sin_cos();
+                let mut t = Vec::new();
+                for dy in -r..=r {
+                    for dx in -r..=r {
+                        let (fx, fy) = (dx as f64, dy as f64);
+                        t.push((
+                            dx,
+                            dy,
+                            (c * fx - s * fy).round() as i32,
+                            (s * fx + c * fy).round() as i32,
+                        ));
+                    }
+                }
+                t
+            })
+            .collect();
+        let sin_cos = (0..ANGLE_BINS)
+            .map(|b| (b as f32 * std::f32::consts::TAU / ANGLE_BINS as f32).sin_cos())
+            .collect();
+        Patch {
+            radius,
+            tables,
+            sin_cos,
+        }
+    }
+
+    /// The offset table of angle bin `b`.
+    #[inline]
+    pub fn table(&self, b: usize) -> &[(i32, i32, i32, i32)] {
+        &self.tables[b % ANGLE_BINS]
+    }
+}
+
+/// Nearest integer, halves away from zero (a cast instead of `libm`'s
+/// `round`, which dominated the propagation step).
+#[inline]
+fn round(v: f32) -> i64 {
+    (v + 0.5f32.copysign(v)) as i64
+}
+
+/// The angle bin of `beta` radians.
+#[inline]
+pub fn angle_bin(beta: f32) -> usize {
+    let t = beta / std::f32::consts::TAU * ANGLE_BINS as f32;
+    (t.round() as i64).rem_euclid(ANGLE_BINS as i64) as usize
+}
+
+/// What a search compares: the periodic source and its direction angles,
+/// the target and its direction angles (radians, pixel axes).
+///
+/// The source is stored padded by its own wrap-around (a margin of
+/// `⌈r√2⌉ + 1` pixels), so a rotated patch is a gather at precomputed
+/// linear offsets with no per-pixel wrapping.
+#[derive(Clone, Debug)]
+pub struct Problem<'a> {
+    /// Tile channels (wrapping).
+    pub source: &'a Channels,
+    /// Tile direction angles.
+    pub source_angle: &'a Grid<f32>,
+    /// Target channels (clamped at the border).
+    pub target: &'a Channels,
+    /// Target direction angles.
+    pub target_angle: &'a Grid<f32>,
+    /// Patch geometry.
+    pub patch: &'a Patch,
+    padded: Vec<f32>,
+    padded_width: usize,
+    margin: usize,
+    linear: Vec<Vec<isize>>,
+    active: Option<&'a [bool]>,
+}
+
+impl<'a> Problem<'a> {
+    /// Sets up a search (pads the source, builds the gather offsets).
+    pub fn new(
+        source: &'a Channels,
+        source_angle: &'a Grid<f32>,
+        target: &'a Channels,
+        target_angle: &'a Grid<f32>,
+        patch: &'a Patch,
+    ) -> Problem<'a> {
+        let margin = (patch.radius as f64 * std::f64::consts::SQRT_2).ceil() as usize + 1;
+        let (w, h, d) = (source.width, source.height, source.depth);
+        let (pw, ph) = (w + 2 * margin, h + 2 * margin);
+        let mut padded = Vec::with_capacity(pw * ph * d);
+        for y in 0..ph {
+            let sy = (y + h * (margin / h + 1) - margin) % h;
+            for x in 0..pw {
+                let sx = (x + w * (margin / w + 1) - margin) % w;
+                padded.extend_from_slice(source.px(sx, sy));
+            }
+        }
+        let linear = (0..ANGLE_BINS)
+            .map(|b| {
+                patch
+                    .table(b)
+                    .iter()
+                    .map(|&(_, _, rx, ry)| (ry as isize * pw as isize + rx as isize) * d as isize)
+                    .collect()
+            })
+            .collect();
+        Problem {
+            source,
+            source_angle,
+            target,
+            target_angle,
+            patch,
+            padded,
+            padded_width: pw,
+            margin,
+            linear,
+            active: None,
+        }
+    }
+
+    /// Restricts the search to the centres flagged in `active` (one flag
+    /// per centre of the field); the others keep their match and cost.
+    pub fn with_active(mut self, active: &'a [bool]) -> Problem<'a> {
+        self.active = Some(active);
+        self
+    }
+
+    /// Whether centre `k` is searched.
+    #[inline]
+    pub fn is_active(&self, k: usize) -> bool {
+        match self.active {
+            Some(a) => a.get(k).copied().unwrap_or(true),
+            None => true,
+        }
+    }
+
+    /// The rotation bin between tile pixel `(px, py)` and target `(qx, qy)`.
+    #[inline]
+    pub fn bin(&self, px: usize, py: usize, qx: usize, qy: usize) -> usize {
+        angle_bin(self.source_angle.get(px, py) - self.target_angle.get(qx, qy))
+    }
+
+    /// The tile pixel that target pixel `(qx + dx, qy + dy)` maps to under
+    /// the match `(px, py)` of centre `(qx, qy)`.
+    #[inline]
+    pub fn map(
+        &self,
+        qx: usize,
+        qy: usize,
+        px: usize,
+        py: usize,
+        dx: i32,
+        dy: i32,
+    ) -> (usize, usize) {
+        let (s, c) = self.patch.sin_cos[self.bin(px, py, qx, qy)];
+        let (fx, fy) = (dx as f32, dy as f32);
+        let rx = round(c * fx - s * fy);
+        let ry = round(s * fx + c * fy);
+        self.wrap(px as i64 + rx, py as i64 + ry)
+    }
+
+    #[inline]
+    fn wrap(&self, x: i64, y: i64) -> (usize, usize) {
+        (
+            x.rem_euclid(self.source.width as i64) as usize,
+            y.rem_euclid(self.source.height as i64) as usize,
+        )
+    }
+
+    /// Gathers the target patch at `(qx, qy)` (clamped at the border).
+    pub fn target_patch(&self, qx: usize, qy: usize, out: &mut Vec<f32>) {
+        out.clear();
+        let t = self.target;
+        let d = t.depth;
+        let r = self.patch.radius as i64;
+        let (x0, x1) = (qx as i64 - r, qx as i64 + r);
+        let inside_x = x0 >= 0 && x1 < t.width as i64;
+        for dy in -r..=r {
+            let y = (qy as i64 + dy).clamp(0, t.height as i64 - 1) as usize;
+            if inside_x {
+                // One contiguous run of the row.
+                let a = (y * t.width + x0 as usize) * d;
+                out.extend_from_slice(&t.data[a..a + (2 * r as usize + 1) * d]);
+            } else {
+                for x in x0..=x1 {
+                    let x = x.clamp(0, t.width as i64 - 1) as usize;
+                    out.extend_from_slice(t.px(x, y));
+                }
+            }
+        }
+    }
+
+    /// Distance between the gathered target patch of `(qx, qy)` and tile
+    /// pixel `(px, py)`; stops early once over `bound`.
+    pub fn distance(
+        &self,
+        tp: &[f32],
+        qx: usize,
+        qy: usize,
+        px: usize,
+        py: usize,
+        bound: f32,
+    ) -> f32 {
+        let d = self.source.depth;
+        let offsets = &self.linear[self.bin(px, py, qx, qy)];
+        let base = (((py + self.margin) * self.padded_width + px + self.margin) * d) as isize;
+        let mut sum = 0.0f32;
+        for (t, &off) in tp.chunks_exact(d).zip(offsets) {
+            let i = (base + off) as usize;
+            let sp = &self.padded[i..i + d];
+            for c in 0..d {
+                let e = sp[c] - t[c];
+                sum += e * e;
+            }
+            if sum > bound {
+                return sum;
+            }
+        }
+        sum
+    }
+
+    /// Recomputes every match's cost against the current target.
+    pub fn refresh(&self, nnf: &mut Nnf) {
+        let costs: Vec<f32> = (0..nnf.matches.len())
+            .into_par_iter()
+            .map_init(Vec::new, |buf, k| {
+                let m = nnf.matches[k];
+                if !self.is_active(k) {
+                    return m.cost;
+                }
+                let (qx, qy) = nnf.centre(k);
+                self.target_patch(qx, qy, buf);
+                self.distance(buf, qx, qy, m.x as usize, m.y as usize, f32::INFINITY)
+            })
+            .collect();
+        for (m, c) in nnf.matches.iter_mut().zip(costs) {
+            m.cost = c;
+        }
+    }
+
+    /// One PatchMatch round: random search, then jump-flooding propagation.
+    /// Costs must be current (see [`Problem::refresh`]).
+    pub fn improve(&self, nnf: &mut Nnf, seed: u64, round: u64) {
+        let (sw, sh) = (self.source.width, self.source.height);
+        let start = Nnf {
+            matches: std::mem::take(&mut nnf.matches),
+            ..*nnf
+        };
+        // Random search (CaTS Alg. 5, windows halving from the tile size).
+        nnf.matches = (0..start.matches.len())
+            .into_par_iter()
+            .map_init(Vec::new, |buf, k| {
+                let mut best = start.matches[k];
+                if !self.is_active(k) {
+                    return best;
+                }
+                let (qx, qy) = start.centre(k);
+                self.target_patch(qx, qy, buf);
+                let mut radius = sw.max(sh) as i64 / 2;
+                let mut i = 0u64;
+                while radius >= 1 {
+                    let key = [seed, round, k as u64, i];
+                    let ox = rng::index(
+                        &[key[0], key[1], key[2], key[3], 0],
+                        2 * radius as usize + 1,
+                    ) as i64
+                        - radius;
+                    let oy = rng::index(
+                        &[key[0], key[1], key[2], key[3], 1],
+                        2 * radius as usize + 1,
+                    ) as i64
+                        - radius;
+                    let (px, py) = self.wrap(best.x as i64 + ox, best.y as i64 + oy);
+                    let c = self.distance(buf, qx, qy, px, py, best.cost);
+                    if c < best.cost {
+                        best = Match {
+                            x: px as u32,
+                            y: py as u32,
+                            cost: c,
+                        };
+                    }
+                    radius /= 2;
+                    i += 1;
+                }
+                best
+            })
+            .collect();
+        // Propagation by jump flooding (CaTS Alg. 6).
+        for step in [4usize, 2, 1] {
+            let prev = Nnf {
+                matches: std::mem::take(&mut nnf.matches),
+                ..*nnf
+            };
+            nnf.matches = (0..prev.matches.len())
+                .into_par_iter()
+                .map_init(Vec::new, |buf, k| {
+                    let mut best = prev.matches[k];
+                    if !self.is_active(k) {
+                        return best;
+                    }
+                    let (i, j) = (k % prev.cols, k / prev.cols);
+                    let (qx, qy) = prev.centre(k);
+                    let mut gathered = false;
+                    let neighbours = [
+                        (i.checked_sub(step), Some(j)),
+                        (Some(i + step).filter(|&v| v < prev.cols), Some(j)),
+                        (Some(i), j.checked_sub(step)),
+                        (Some(i), Some(j + step).filter(|&v| v < prev.rows)),
+                    ];
+                    for (ni, nj) in neighbours {
+                        let (Some(ni), Some(nj)) = (ni, nj) else {
+                            continue;
+                        };
+                        let n = prev.matches[nj * prev.cols + ni];
+                        let (nx, ny) = (ni * prev.spacing, nj * prev.spacing);
+                        let dx = qx as i32 - nx as i32;
+                        let dy = qy as i32 - ny as i32;
+                        let (px, py) = self.map(nx, ny, n.x as usize, n.y as usize, dx, dy);
+                        if px == best.x as usize && py == best.y as usize {
+                            continue;
+                        }
+                        if !gathered {
+                            self.target_patch(qx, qy, buf);
+                            gathered = true;
+                        }
+                        let c = self.distance(buf, qx, qy, px, py, best.cost);
+                        if c < best.cost {
+                            best = Match {
+                                x: px as u32,
+                                y: py as u32,
+                                cost: c,
+                            };
+                        }
+                    }
+                    best
+                })
+                .collect();
+        }
+    }
+
+    /// The exact nearest tile pixel of centre `(qx, qy)` by exhaustive
+    /// search (first minimum in row-major order): the reference for tests.
+    pub fn brute_force(&self, qx: usize, qy: usize) -> Match {
+        let mut buf = Vec::new();
+        self.target_patch(qx, qy, &mut buf);
+        let mut best = Match {
+            x: 0,
+            y: 0,
+            cost: f32::INFINITY,
+        };
+        for py in 0..self.source.height {
+            for px in 0..self.source.width {
+                let c = self.distance(&buf, qx, qy, px, py, f32::INFINITY);
+                if c < best.cost {
+                    best = Match {
+                        x: px as u32,
+                        y: py as u32,
+                        cost: c,
+                    };
+                }
+            }
+        }
+        best
+    }
+}
+
+/// A field of matches seeded at random (hash of seed and centre).
+pub fn random_nnf(
+    width: usize,
+    height: usize,
+    spacing: usize,
+    source: &Channels,
+    seed: u64,
+) -> Nnf {
+    let (cols, rows) = Nnf::shape(width, height, spacing);
+    let matches = (0..cols * rows)
+        .map(|k| Match {
+            x: rng::index(&[seed, 0x5EED, k as u64, 0], source.width) as u32,
+            y: rng::index(&[seed, 0x5EED, k as u64, 1], source.height) as u32,
+            cost: f32::INFINITY,
+        })
+        .collect();
+    Nnf {
+        cols,
+        rows,
+        spacing,
+        matches,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn noise(w: usize, h: usize, d: usize, seed: u64) -> Channels {
+        Channels {
+            width: w,
+            height: h,
+            depth: d,
+            data: (0..w * h * d)
+                .map(|i| rng::unit(&[seed, i as u64]) as f32)
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn finds_the_exact_match_of_a_copy() {
+        // Target: a 40×30 window of a 32×32 noise tile, starting at (5, 9),
+        // wrapping. Every centre's exact match is its own source pixel.
+        let src = noise(32, 32, 3, 1);
+        let (w, h) = (40, 30);
+        let mut data = Vec::new();
+        for y in 0..h {
+            for x in 0..w {
+                data.extend_from_slice(src.px((x + 5) % 32, (y + 9) % 32));
+            }
+        }
+        let tgt = Channels {
+            width: w,
+            height: h,
+            depth: 3,
+            data,
+        };
+        let zero_s = Grid::new(32, 32, 0.0);
+        let zero_t = Grid::new(w, h, 0.0);
+        let patch = Patch::new(3);
+        let pb = Problem::new(&src, &zero_s, &tgt, &zero_t, &patch);
+        let mut nnf = random_nnf(w, h, 2, &src, 7);
+        pb.refresh(&mut nnf);
+        for round in 0..6 {
+            pb.improve(&mut nnf, 7, round);
+        }
+        let mut exact = 0;
+        for k in 0..nnf.matches.len() {
+            let (qx, qy) = nnf.centre(k);
+            // Border centres see clamped pixels: only interior ones count.
+            if qx < 3 || qy < 3 || qx + 3 >= w || qy + 3 >= h {
+                continue;
+            }
+            let m = nnf.matches[k];
+            let bf = pb.brute_force(qx, qy);
+            assert_eq!(
+                (bf.x, bf.y),
+                (((qx + 5) % 32) as u32, ((qy + 9) % 32) as u32)
+            );
+            assert_eq!(bf.cost, 0.0);
+            if (m.x, m.y) == (bf.x, bf.y) {
+                exact += 1;
+            }
+        }
+        let interior = (0..nnf.matches.len())
+            .filter(|&k| {
+                let (qx, qy) = nnf.centre(k);
+                !(qx < 3 || qy < 3 || qx + 3 >= w || qy + 3 >= h)
+            })
+            .count();
+        assert_eq!(exact, interior, "{exact} of {interior} exact");
+    }
+
+    #[test]
+    fn rotation_tables_turn_offsets() {
+        let p = Patch::new(2);
+        // A quarter turn (bin 8 of 32) maps (1, 0) to (0, 1).
+        let t = p.table(8);
+        let e = t.iter().find(|e| (e.0, e.1) == (1, 0)).unwrap();
+        assert_eq!((e.2, e.3), (0, 1));
+        assert_eq!(angle_bin(std::f32::consts::FRAC_PI_2), 8);
+        assert_eq!(angle_bin(-std::f32::consts::FRAC_PI_2), 24);
+    }
+
+    #[test]
+    fn a_rotated_copy_is_found_with_its_rotation() {
+        // Source angle 0, target angle −90°: β = +90°; target patch offsets
+        // (dx, dy) read tile offsets (−dy, dx). Build the target that way.
+        let src = noise(24, 24, 2, 3);
+        let (w, h) = (20, 20);
+        let (cx, cy) = (10i64, 10i64);
+        let mut data = Vec::new();
+        for y in 0..h as i64 {
+            for x in 0..w as i64 {
+                let (dx, dy) = (x - cx, y - cy);
+                let sx = (7 - dy).rem_euclid(24) as usize;
+                let sy = (4 + dx).rem_euclid(24) as usize;
+                data.extend_from_slice(src.px(sx, sy));
+            }
+        }
+        let tgt = Channels {
+            width: w,
+            height: h,
+            depth: 2,
+            data,
+        };
+        let sa = Grid::new(24, 24, 0.0);
+        let ta = Grid::new(w, h, -std::f32::consts::FRAC_PI_2);
+        let patch = Patch::new(2);
+        let pb = Problem::new(&src, &sa, &tgt, &ta, &patch);
+        let bf = pb.brute_force(10, 10);
+        assert_eq!((bf.x, bf.y, bf.cost), (7, 4, 0.0));
+    }
+}

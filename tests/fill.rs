@@ -1,0 +1,378 @@
+//! End-to-end tests of `flourish fill`: ink fraction and containment per
+//! region, thread-count determinism, bad input, EM energy, golden files.
+//!
+//! The shipped styles run at a 64 px tile (`resolution` override) so the
+//! file stays fast. `UPDATE_GOLDEN=1 cargo test --test fill` rewrites
+//! `golden/fill/`.
+
+use flourish::field::diffusion::constant_field;
+use flourish::fill::tile::{SourceDirection, Tile};
+use flourish::fill::{em, fill_sketch, FillOptions, FillOutput};
+use flourish::sketch::{self, QueryKind};
+use flourish::svg_out::FillRule;
+use kurbo::{BezPath, Line, ParamCurve, PathSeg, Point, Shape as _};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn opts(style: &str) -> FillOptions {
+    FillOptions {
+        style: style.into(),
+        styles_dir: root().join("styles"),
+        resolution: Some(64),
+        ..Default::default()
+    }
+}
+
+fn sample(name: &str) -> PathBuf {
+    root().join("samples/fill").join(format!("{name}.svg"))
+}
+
+fn run(style: &str, name: &str) -> FillOutput {
+    let sk = sketch::load(&sample(name)).unwrap();
+    fill_sketch(&opts(style), &sk).unwrap()
+}
+
+/// At the style's own resolution (96 px tiles).
+fn run_full(style: &str, name: &str) -> FillOutput {
+    let sk = sketch::load(&sample(name)).unwrap();
+    let o = FillOptions {
+        resolution: None,
+        ..opts(style)
+    };
+    fill_sketch(&o, &sk).unwrap()
+}
+
+/// Distance from `p` to the outline's flattened segments.
+fn outline_distance(outline: &BezPath, p: Point) -> f64 {
+    let mut segs: Vec<Line> = Vec::new();
+    flourish::raster::input::flatten_segments(outline, 0.01, &mut segs);
+    segs.iter()
+        .map(|l| flourish::raster::sdf::point_segment_distance(p, *l))
+        .fold(f64::INFINITY, f64::min)
+}
+
+fn inside(outline: &BezPath, rule: FillRule, p: Point) -> bool {
+    let w = outline.winding(p);
+    match rule {
+        FillRule::NonZero => w != 0,
+        FillRule::EvenOdd => w % 2 != 0,
+    }
+}
+
+#[test]
+fn ink_fraction_and_containment_per_region() {
+    for style in ["knot", "scales"] {
+        for name in ["circle", "star", "letter", "frame"] {
+            let out = run_full(style, name);
+            let sk = sketch::load(&sample(name)).unwrap();
+            let (outline, rule) = sk
+                .queries
+                .iter()
+                .find_map(|q| match &q.kind {
+                    QueryKind::Region { outline, fill_rule } => Some((outline.clone(), *fill_rule)),
+                    _ => None,
+                })
+                .unwrap();
+            assert_eq!(out.regions.len(), 1);
+            let r = &out.regions[0];
+            let (f, t) = (r.ink_fraction(), r.tile_ink);
+            println!("{style}/{name}: ink {f:.3}, tile {t:.3}");
+            assert!(
+                (f - t).abs() <= 0.15 * t,
+                "{style}/{name}: ink {f:.3}, tile {t:.3}"
+            );
+            // No ink outside: every point of every traced curve is inside
+            // the region or within the tracing tolerance of its outline.
+            // Tolerance: 0.25 px tracing plus the linear interpolation of the
+            // contour at acute corners of the clip (star tips), 0.5 px in all.
+            let tol = 0.5 / r.region.sdf.px_per_unit();
+            let mut n = 0;
+            for layer in &r.paths {
+                for p in layer {
+                    for seg in p.segments() {
+                        for k in 0..8 {
+                            let q = seg.eval(k as f64 / 8.0);
+                            n += 1;
+                            if !inside(&outline, rule, q) {
+                                let d = outline_distance(&outline, q);
+                                assert!(d <= tol, "{style}/{name}: ink at {q:?}, {d} outside");
+                            }
+                        }
+                    }
+                }
+            }
+            assert!(n > 100, "{style}/{name}: only {n} curve samples");
+            let _ = PathSeg::Line(Line::new((0.0, 0.0), (1.0, 1.0)));
+        }
+    }
+}
+
+#[test]
+fn one_and_two_threads_give_identical_bytes() {
+    let svg = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| run("scales", "combed").to_document().to_svg())
+    };
+    assert_eq!(svg(1), svg(2));
+}
+
+#[test]
+fn combing_turns_the_direction_under_the_stroke() {
+    let out = run("knot", "combed");
+    let r = &out.regions[0];
+    // The stroke rises to the right at its end (direction ≈ +x there) and
+    // runs up-right in its middle: near (100, 100) the field points up.
+    let to_px = r.region.sdf.to_user.inverse();
+    let p = to_px * Point::new(100.0, 100.0);
+    let d = r.region.direction.get(p.x as usize, p.y as usize);
+    assert!(d[1] < -0.4, "{d:?}");
+}
+
+#[test]
+fn energy_decreases_over_the_em_iterations_at_each_level() {
+    let tile = Tile::load(
+        &root().join("styles/scales/tile.svg"),
+        64,
+        SourceDirection::Constant([1.0, 0.0]),
+    )
+    .unwrap();
+    let dir = constant_field(96, 96, [1.0, 0.0]);
+    let params = em::EmParams {
+        levels: 2,
+        iterations: 6,
+        ..Default::default()
+    };
+    let s = em::synthesize(&tile, &dir, &params);
+    assert_eq!(s.energy.len(), 2);
+    // Levels after the coarsest start from the upsampled image and must
+    // improve on it. The coarsest starts from the quilted copy, whose
+    // interior energy is already 0 (every neighbourhood a tile
+    // neighbourhood); it can only pick up the seams' and the grid edge's
+    // disagreement, so it must stay small.
+    for (level, e) in s.energy.iter().enumerate().skip(1) {
+        let (first, last) = (e[0], e[e.len() - 1]);
+        assert!(last < first, "level {level}: {e:?}");
+    }
+    let coarse = &s.energy[0];
+    assert!(coarse[0] < 1e-3, "{coarse:?}");
+    let finest = &s.energy[1];
+    assert!(
+        coarse.iter().all(|&e| e < finest[0]),
+        "{coarse:?} vs {finest:?}"
+    );
+}
+
+/// Runs the binary; returns (status, stderr).
+fn cli(args: &[&str]) -> (i32, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_flourish"))
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn write_sketch(dir: &Path, name: &str, body: &str) -> String {
+    let p = dir.join(name);
+    std::fs::write(
+        &p,
+        format!(
+            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"200\" height=\"200\">{body}</svg>"
+        ),
+    )
+    .unwrap();
+    p.to_string_lossy().into_owned()
+}
+
+#[test]
+fn bad_inputs_fail_with_one_clear_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.svg");
+    let out = out.to_str().unwrap();
+    let styles = root().join("styles");
+    let styles = styles.to_str().unwrap();
+    let open = sample("open-only");
+    let speck = write_sketch(
+        dir.path(),
+        "speck.svg",
+        "<circle cx=\"50\" cy=\"50\" r=\"0.05\" fill=\"#000\"/>",
+    );
+    let huge = write_sketch(
+        dir.path(),
+        "huge.svg",
+        "<rect x=\"0\" y=\"0\" width=\"9000\" height=\"9000\" fill=\"#000\"/>",
+    );
+    // A style whose tile has no ink.
+    let empty = dir.path().join("empty");
+    std::fs::create_dir(&empty).unwrap();
+    std::fs::write(
+        empty.join("tile.svg"),
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"32\" height=\"32\"></svg>",
+    )
+    .unwrap();
+    std::fs::write(
+        empty.join("style.toml"),
+        "kind = \"fill\"\n[[exemplar]]\nfile = \"tile.svg\"\n",
+    )
+    .unwrap();
+    let circle = sample("circle");
+    for (args, needle) in [
+        (
+            vec![
+                "fill",
+                "--styles",
+                styles,
+                open.to_str().unwrap(),
+                "-o",
+                out,
+            ],
+            "only open paths",
+        ),
+        (
+            vec!["fill", "--styles", styles, &speck, "-o", out],
+            "smaller than one tile pixel",
+        ),
+        (
+            vec!["fill", "--styles", styles, &huge, "-o", out],
+            "size limit",
+        ),
+        (
+            vec![
+                "fill",
+                "--style",
+                empty.to_str().unwrap(),
+                circle.to_str().unwrap(),
+                "-o",
+                out,
+            ],
+            "no ink",
+        ),
+    ] {
+        let (code, err) = cli(&args);
+        assert_eq!(code, 1, "{args:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        assert!(err.contains(needle), "{err}");
+        assert!(!Path::new(out).exists());
+    }
+}
+
+/// Compares with the golden file byte for byte; `UPDATE_GOLDEN=1` rewrites.
+fn check_golden(name: &str, actual: &str) {
+    let path = root().join("golden/fill").join(name);
+    if std::env::var_os("UPDATE_GOLDEN").is_some() {
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::write(&path, actual).unwrap();
+        return;
+    }
+    let expected = std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("{}: {e}; run with UPDATE_GOLDEN=1", path.display()));
+    assert!(
+        expected == actual,
+        "{} differs; run with UPDATE_GOLDEN=1 and review",
+        path.display()
+    );
+}
+
+#[test]
+fn golden_outputs() {
+    for (style, name) in [
+        ("knot", "circle"),
+        ("scales", "star"),
+        ("knot", "letter"),
+        ("scales", "frame"),
+        ("knot", "combed"),
+    ] {
+        let svg = run(style, name).to_document().to_svg();
+        check_golden(&format!("{name}-{style}.svg"), &svg);
+    }
+}
+
+#[test]
+fn a_direction_file_combs_every_region() {
+    let dir = tempfile::tempdir().unwrap();
+    let strokes = write_sketch(
+        dir.path(),
+        "d.svg",
+        "<path d=\"M10 100H190\" fill=\"none\" stroke=\"#000\" stroke-width=\"60\"/>",
+    );
+    let sk = sketch::load(&sample("star")).unwrap();
+    let plain = fill_sketch(&opts("knot"), &sk).unwrap();
+    let combed = fill_sketch(
+        &FillOptions {
+            direction: Some(PathBuf::from(&strokes)),
+            ..opts("knot")
+        },
+        &sk,
+    )
+    .unwrap();
+    // Under the stroke the field is the stroke's direction (+x); the
+    // boundary flow there was not.
+    let r = &combed.regions[0].region;
+    let p = r.sdf.to_user.inverse() * Point::new(100.0, 100.0);
+    let d = r.direction.get(p.x as usize, p.y as usize);
+    assert!(d[0] > 0.95, "{d:?}");
+    assert_ne!(plain.to_document().to_svg(), combed.to_document().to_svg());
+    // A direction file without open paths is refused.
+    let bad = write_sketch(
+        dir.path(),
+        "bad.svg",
+        "<circle cx=\"9\" cy=\"9\" r=\"5\" fill=\"#000\"/>",
+    );
+    let e = fill_sketch(
+        &FillOptions {
+            direction: Some(PathBuf::from(&bad)),
+            ..opts("knot")
+        },
+        &sk,
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("no open stroked path"), "{e}");
+}
+
+#[test]
+fn a_png_tile_fills_a_region() {
+    // Diagonal dark stripes 12 px wide every 32 px on white, seamless at 64².
+    let dir = tempfile::tempdir().unwrap();
+    let img = image::RgbImage::from_fn(64, 64, |x, y| {
+        if (x + y) % 32 < 12 {
+            image::Rgb([30, 40, 90])
+        } else {
+            image::Rgb([255, 255, 255])
+        }
+    });
+    img.save(dir.path().join("tile.png")).unwrap();
+    std::fs::write(
+        dir.path().join("style.toml"),
+        "kind = \"fill\"\ndirection = [1.0, 0.0]\nlevels = 2\n[[exemplar]]\nfile = \"tile.png\"\n",
+    )
+    .unwrap();
+    let sketch = write_sketch(
+        dir.path(),
+        "s.svg",
+        "<circle cx=\"50\" cy=\"50\" r=\"40\" fill=\"#ccc\"/>",
+    );
+    let sk = sketch::load(Path::new(&sketch)).unwrap();
+    let o = FillOptions {
+        style: dir.path().to_string_lossy().into_owned(),
+        ..opts("knot")
+    };
+    let out = fill_sketch(&o, &sk).unwrap();
+    let r = &out.regions[0];
+    assert_eq!(r.colors.len(), 1);
+    let (f, t) = (r.ink_fraction(), r.tile_ink);
+    println!("png stripes: ink {f:.3}, tile {t:.3}");
+    assert!((t - 12.0 / 32.0).abs() < 0.05, "{t}");
+    // Straight stripes bent into rings by the boundary flow: without the
+    // histogram weight of the votes this lost a fifth of its ink.
+    assert!((f - t).abs() <= 0.15 * t, "ink {f:.3}, tile {t:.3}");
+}
