@@ -57,6 +57,15 @@ pub enum Error {
         /// What is wrong with it.
         reason: String,
     },
+    /// A computation's input is degenerate and no file is concerned (a mesh
+    /// with zero-area triangles, a matching with no candidates…).
+    #[error("{subject}: {reason}")]
+    Degenerate {
+        /// What the input is (e.g. "ARAP mesh", "piecewise matching").
+        subject: String,
+        /// What is wrong with it.
+        reason: String,
+    },
     /// An option has a value the library cannot use.
     #[error("invalid option {name}: {reason}")]
     Option {
@@ -73,6 +82,14 @@ impl Error {
         Error::Io {
             path: path.into(),
             source,
+        }
+    }
+
+    /// An [`Error::Degenerate`] for `subject`.
+    pub fn degenerate(subject: impl Into<String>, reason: impl Into<String>) -> Self {
+        Error::Degenerate {
+            subject: subject.into(),
+            reason: reason.into(),
         }
     }
 

@@ -11,6 +11,7 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+pub mod brush;
 pub mod diff;
 pub mod error;
 pub mod field;

@@ -1,0 +1,567 @@
+//! Piecewise matching (decobrush.txt §5.1, adapting Lu et al. 2013): cover
+//! the query spine with a sequence of exemplar segments.
+//!
+//! Every query sample `q` is assigned an exemplar sample `(e, s)`; inside a
+//! segment consecutive query samples take consecutive exemplar samples
+//! (exemplars keep their direction: the paper's strokes have a start and an
+//! end, Fig. 5). The cost of an assignment is
+//! - a **data term** per sample: the weighted squared difference of the
+//!   feature vectors (turning angle, width, distances to both ends clamped at
+//!   a horizon, so only samples near an end are told apart by them);
+//! - a heavy **end penalty** when a query sample near an end of the query is
+//!   matched to an exemplar sample that is not near the same end (the curls
+//!   at the ends must not be cut short), and a **middle penalty** when a
+//!   middle query sample takes an exemplar end;
+//! - a **jump penalty** at every segment boundary, plus the squared
+//!   difference of the two boundary samples' appearance descriptors and
+//!   thicknesses (rib lengths), so jumps happen only between look-alikes;
+//! - a minimum segment length (in samples).
+//!
+//! The minimum is found by dynamic programming over (query sample,
+//! candidate, run length capped at the minimum segment length). Candidates
+//! per query sample are the `candidates` best exemplar samples by data term
+//! plus the continuations of the `beam` best states of the previous sample,
+//! so the cost is O(query × candidates²); with unlimited candidates the DP is
+//! exact (tested against exhaustive enumeration of segmentations). Near-equal
+//! choices are broken by a hash of (seed, position, choice), so `--seed`
+//! varies the result deterministically.
+
+use crate::brush::query::QuerySpine;
+use crate::error::{Error, Result};
+use crate::pattern::rng;
+use std::collections::HashMap;
+use std::ops::Range;
+
+/// The matching features of one spine sample (decobrush.txt §5.1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SampleFeature {
+    /// Signed turning angle, radians (curvature × spacing).
+    pub turning: f64,
+    /// Ornament width (rib length), in the common length unit.
+    pub width: f64,
+    /// Arc length from the spine's start, in the common length unit.
+    pub dist_start: f64,
+    /// Arc length to the spine's end, in the common length unit.
+    pub dist_end: f64,
+}
+
+/// The features along one spine, query or exemplar. Query and exemplars
+/// must share a length unit and a sample spacing (the caller resamples the
+/// exemplar spines at the query's spacing, scaled by the width ratio).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SpineFeatures {
+    /// One feature per sample, from start to end.
+    pub samples: Vec<SampleFeature>,
+    /// Appearance descriptor per sample (e.g. mean ink and ink width over
+    /// the rib), compared across segment boundaries; all of one length, or
+    /// empty when the spine has none (the query).
+    pub appearance: Vec<Vec<f64>>,
+}
+
+impl SpineFeatures {
+    /// The features of a query spine (no appearance descriptors).
+    pub fn from_query(q: &QuerySpine) -> Self {
+        SpineFeatures {
+            samples: q
+                .samples
+                .iter()
+                .map(|s| SampleFeature {
+                    turning: s.turning,
+                    width: s.width,
+                    dist_start: s.dist_start,
+                    dist_end: s.dist_end,
+                })
+                .collect(),
+            appearance: Vec::new(),
+        }
+    }
+}
+
+/// Weights and limits of the matching; lengths are in multiples of the
+/// query's mean width, costs are unitless.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MatchOptions {
+    /// Exemplar samples kept per query sample by data term (default 16;
+    /// `usize::MAX` makes the search exact).
+    pub candidates: usize,
+    /// Best previous states whose continuations are also candidates
+    /// (default 16).
+    pub beam: usize,
+    /// Weight of the squared turning-angle difference, per rad² (default 400).
+    pub w_turning: f64,
+    /// Weight of the squared width difference over the mean width (default 1).
+    pub w_width: f64,
+    /// Weight of the squared difference of each clamped end distance over
+    /// the horizon (default 1).
+    pub w_ends: f64,
+    /// Distance beyond which end distances are all alike, widths (default 2).
+    pub end_horizon: f64,
+    /// Distance from an end within which a sample belongs to that end,
+    /// widths (default 0.5).
+    pub end_zone: f64,
+    /// Penalty for a query end sample matched off that exemplar end (100).
+    pub end_penalty: f64,
+    /// Penalty for a middle query sample matched to an exemplar end (10).
+    pub middle_penalty: f64,
+    /// Cost of every segment boundary (default 2).
+    pub jump_penalty: f64,
+    /// Weight of the squared appearance difference at a boundary (10).
+    pub w_appearance: f64,
+    /// Weight of the squared thickness difference over the mean width at a
+    /// boundary (10).
+    pub w_thickness: f64,
+    /// Shortest segment, in samples (default 5; shorter queries are one
+    /// segment).
+    pub min_segment: usize,
+    /// Samples by which each segment is extended into its neighbours
+    /// (default 4).
+    pub overlap: usize,
+    /// Seed of the tie-breaking hash.
+    pub seed: u64,
+    /// Costs closer than this (relative) count as ties (default 1e-9).
+    pub tie_tolerance: f64,
+}
+
+impl Default for MatchOptions {
+    fn default() -> Self {
+        MatchOptions {
+            candidates: 16,
+            beam: 16,
+            w_turning: 400.0,
+            w_width: 1.0,
+            w_ends: 1.0,
+            end_horizon: 2.0,
+            end_zone: 0.5,
+            end_penalty: 100.0,
+            middle_penalty: 10.0,
+            jump_penalty: 2.0,
+            w_appearance: 10.0,
+            w_thickness: 10.0,
+            min_segment: 5,
+            overlap: 4,
+            seed: 0,
+            tie_tolerance: 1e-9,
+        }
+    }
+}
+
+/// One matched exemplar segment.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct MatchedSegment {
+    /// Index of the exemplar.
+    pub exemplar: usize,
+    /// Query samples this segment owns (the segments' cores tile the query).
+    pub core: Range<usize>,
+    /// Query samples it covers once extended into its neighbours.
+    pub query: Range<usize>,
+    /// Exemplar samples matched to `query`, same length, same direction.
+    pub exemplar_samples: Range<usize>,
+}
+
+/// The result of [`match_query`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Matching {
+    /// Segments from the query's start to its end.
+    pub segments: Vec<MatchedSegment>,
+    /// Total cost of the cores' assignment (data + penalties + jumps).
+    pub cost: f64,
+}
+
+/// Where along its spine a sample lies, for the end penalties.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Zone {
+    Start,
+    Middle,
+    End,
+}
+
+/// A prepared matching problem: normalized features and the cost terms.
+pub struct Problem<'a> {
+    query: &'a SpineFeatures,
+    exemplars: &'a [SpineFeatures],
+    opts: &'a MatchOptions,
+    mean_width: f64,
+    horizon: f64,
+    zone: f64,
+}
+
+impl<'a> Problem<'a> {
+    /// Validates the inputs and prepares the normalizations.
+    pub fn new(
+        query: &'a SpineFeatures,
+        exemplars: &'a [SpineFeatures],
+        opts: &'a MatchOptions,
+    ) -> Result<Self> {
+        let bad = |r: String| Err(Error::degenerate("piecewise matching", r));
+        if query.samples.is_empty() {
+            return bad("the query has no samples".into());
+        }
+        if exemplars.iter().all(|e| e.samples.is_empty()) {
+            return bad("no exemplar has samples".into());
+        }
+        let finite = |f: &SampleFeature| {
+            f.turning.is_finite()
+                && f.width.is_finite()
+                && f.dist_start.is_finite()
+                && f.dist_end.is_finite()
+        };
+        let dim = exemplars
+            .iter()
+            .flat_map(|e| e.appearance.first())
+            .map(Vec::len)
+            .next()
+            .unwrap_or(0);
+        for (i, e) in exemplars.iter().enumerate() {
+            if !e.samples.iter().all(finite) {
+                return bad(format!("exemplar {i} has a non-finite feature"));
+            }
+            let ok_app = e.appearance.is_empty()
+                || e.appearance.len() == e.samples.len()
+                    && e.appearance
+                        .iter()
+                        .all(|a| a.len() == dim && a.iter().all(|v| v.is_finite()));
+            if !ok_app {
+                return bad(format!(
+                    "exemplar {i}: appearance descriptors missing, of unequal length or not finite"
+                ));
+            }
+        }
+        if !query.samples.iter().all(finite) {
+            return bad("the query has a non-finite feature".into());
+        }
+        let n = query.samples.len() as f64;
+        let mean_width = query.samples.iter().map(|s| s.width).sum::<f64>() / n;
+        if mean_width <= 0.0 {
+            return bad("the query has no width".into());
+        }
+        Ok(Problem {
+            query,
+            exemplars,
+            opts,
+            mean_width,
+            horizon: opts.end_horizon.max(1e-9) * mean_width,
+            zone: opts.end_zone * mean_width,
+        })
+    }
+
+    fn zone_of(&self, f: &SampleFeature) -> Zone {
+        if f.dist_start < self.zone && f.dist_start <= f.dist_end {
+            Zone::Start
+        } else if f.dist_end < self.zone {
+            Zone::End
+        } else {
+            Zone::Middle
+        }
+    }
+
+    /// The data term and end penalties of matching query sample `q` to
+    /// sample `s` of exemplar `e` (indices must be in range).
+    pub fn unary(&self, q: usize, e: usize, s: usize) -> f64 {
+        let (Some(a), Some(b)) = (
+            self.query.samples.get(q),
+            self.exemplars.get(e).and_then(|x| x.samples.get(s)),
+        ) else {
+            return f64::INFINITY;
+        };
+        let o = self.opts;
+        let h = self.horizon;
+        let clamp = |d: f64| d.clamp(0.0, h) / h;
+        let dt = a.turning - b.turning;
+        let dw = (a.width - b.width) / self.mean_width;
+        let ds = clamp(a.dist_start) - clamp(b.dist_start);
+        let de = clamp(a.dist_end) - clamp(b.dist_end);
+        let mut c = o.w_turning * dt * dt + o.w_width * dw * dw + o.w_ends * (ds * ds + de * de);
+        let (zq, ze) = (self.zone_of(a), self.zone_of(b));
+        if zq != ze {
+            c += if zq == Zone::Middle {
+                o.middle_penalty
+            } else {
+                o.end_penalty
+            };
+        }
+        c
+    }
+
+    /// The cost of a boundary from exemplar sample `from` (the last of a
+    /// segment) to `to` (the first of the next).
+    pub fn jump(&self, from: (usize, usize), to: (usize, usize)) -> f64 {
+        let o = self.opts;
+        let get = |(e, s): (usize, usize)| {
+            let x = self.exemplars.get(e)?;
+            Some((x.samples.get(s)?, x.appearance.get(s)))
+        };
+        let (Some((fa, aa)), Some((fb, ab))) = (get(from), get(to)) else {
+            return f64::INFINITY;
+        };
+        let dw = (fa.width - fb.width) / self.mean_width;
+        let app: f64 = match (aa, ab) {
+            (Some(x), Some(y)) => x.iter().zip(y).map(|(u, v)| (u - v) * (u - v)).sum(),
+            _ => 0.0,
+        };
+        o.jump_penalty + o.w_appearance * app + o.w_thickness * dw * dw
+    }
+
+    /// Number of query samples.
+    pub fn query_len(&self) -> usize {
+        self.query.samples.len()
+    }
+
+    /// Sample counts of the exemplars.
+    pub fn exemplar_lens(&self) -> Vec<usize> {
+        self.exemplars.iter().map(|e| e.samples.len()).collect()
+    }
+
+    /// The effective shortest segment: the option, at least 1, at most the
+    /// query's length.
+    pub fn min_segment(&self) -> usize {
+        self.opts.min_segment.clamp(1, self.query_len())
+    }
+
+    /// The cost of a segmentation given as (exemplar, first exemplar sample,
+    /// query range) triples tiling the query, as the DP counts it.
+    pub fn cost_of(&self, segs: &[(usize, usize, Range<usize>)]) -> f64 {
+        let mut c = 0.0;
+        let mut last: Option<(usize, usize)> = None;
+        for (e, s0, r) in segs {
+            if let Some(l) = last {
+                c += self.jump(l, (*e, *s0));
+            }
+            for (k, q) in r.clone().enumerate() {
+                c += self.unary(q, *e, s0 + k);
+            }
+            last = Some((*e, s0 + r.len().saturating_sub(1)));
+        }
+        c
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+enum Back {
+    Start,
+    Continue(usize, usize),
+    Jump(usize, usize),
+}
+
+/// One DP layer: candidates and, per candidate, cost and back pointer per
+/// run length 1..=L (index r − 1).
+struct Layer {
+    cands: Vec<(usize, usize)>,
+    cost: Vec<f64>,
+    back: Vec<Back>,
+}
+
+/// Matches `query` against `exemplars` (decobrush.txt §5.1) and returns the
+/// segments, extended by `opts.overlap` samples into their neighbours.
+pub fn match_query(
+    query: &SpineFeatures,
+    exemplars: &[SpineFeatures],
+    opts: &MatchOptions,
+) -> Result<Matching> {
+    let p = Problem::new(query, exemplars, opts)?;
+    let n = p.query_len();
+    let lmin = p.min_segment();
+    let lens = p.exemplar_lens();
+    let tol = |c: f64| opts.tie_tolerance * (1.0 + c.abs());
+    let mut layers: Vec<Layer> = Vec::with_capacity(n);
+    for q in 0..n {
+        let cands = candidates(&p, q, layers.last(), lmin, &lens);
+        let m = cands.len();
+        let mut cost = vec![f64::INFINITY; m * lmin];
+        let mut back = vec![Back::Start; m * lmin];
+        // Offers a value for slot (c, r); near-ties go to the lower hash.
+        let mut offer = |slot: usize, v: f64, b: Back, key: u64| {
+            let cur = cost[slot];
+            let better = !cur.is_finite()
+                || v < cur - tol(cur)
+                || (v <= cur + tol(cur) && key < back_key(opts.seed, q, slot, back[slot]));
+            if v.is_finite() && better {
+                cost[slot] = v;
+                back[slot] = b;
+            }
+        };
+        for (ci, &(e, s)) in cands.iter().enumerate() {
+            let u = p.unary(q, e, s);
+            if !u.is_finite() {
+                continue;
+            }
+            let Some(prev) = layers.last() else {
+                offer(
+                    ci * lmin,
+                    u,
+                    Back::Start,
+                    back_key(opts.seed, q, ci * lmin, Back::Start),
+                );
+                continue;
+            };
+            // A new segment after a complete one (run length ≥ L).
+            for (pi, &pc) in prev.cands.iter().enumerate() {
+                let v = prev.cost[pi * lmin + lmin - 1];
+                if v.is_finite() {
+                    let b = Back::Jump(pi, lmin - 1);
+                    let w = v + p.jump(pc, (e, s)) + u;
+                    offer(ci * lmin, w, b, back_key(opts.seed, q, ci * lmin, b));
+                }
+            }
+            // Continuing the segment that matched (e, s − 1).
+            if s > 0 {
+                if let Some(pi) = prev.cands.iter().position(|&c| c == (e, s - 1)) {
+                    for r in 0..lmin {
+                        let v = prev.cost[pi * lmin + r];
+                        if v.is_finite() {
+                            let slot = ci * lmin + (r + 1).min(lmin - 1);
+                            let b = Back::Continue(pi, r);
+                            offer(slot, v + u, b, back_key(opts.seed, q, slot, b));
+                        }
+                    }
+                }
+            }
+        }
+        layers.push(Layer { cands, cost, back });
+    }
+    // The best complete state at the last sample.
+    let last = layers
+        .last()
+        .ok_or_else(|| Error::degenerate("piecewise matching", "empty query"))?;
+    let mut best: Option<(usize, f64, u64)> = None;
+    for ci in 0..last.cands.len() {
+        let slot = ci * lmin + lmin - 1;
+        let v = last.cost[slot];
+        if !v.is_finite() {
+            continue;
+        }
+        let key = rng::hash(&[opts.seed, n as u64, ci as u64, 0xE2D]);
+        let take = match best {
+            None => true,
+            Some((_, bv, bk)) => v < bv - tol(bv) || (v <= bv + tol(bv) && key < bk),
+        };
+        if take {
+            best = Some((slot, v, key));
+        }
+    }
+    let Some((mut slot, total, _)) = best else {
+        return Err(Error::degenerate(
+            "piecewise matching",
+            format!("no exemplar segment of at least {lmin} samples fits the query"),
+        ));
+    };
+    // Backtrack: assignment per query sample and segment starts.
+    let mut assign = vec![(0usize, 0usize); n];
+    let mut starts = vec![false; n];
+    for q in (0..n).rev() {
+        let layer = &layers[q];
+        assign[q] = layer.cands[slot / lmin];
+        match layer.back[slot] {
+            Back::Start => starts[q] = true,
+            Back::Jump(pi, r) => {
+                starts[q] = true;
+                slot = pi * lmin + r;
+            }
+            Back::Continue(pi, r) => slot = pi * lmin + r,
+        }
+    }
+    Ok(Matching {
+        segments: segments_of(&assign, &starts, &lens, opts.overlap),
+        cost: total,
+    })
+}
+
+/// A key for tie-breaking a slot's choice, from (seed, position, choice).
+fn back_key(seed: u64, q: usize, slot: usize, b: Back) -> u64 {
+    let (tag, i, r) = match b {
+        Back::Start => (1, 0, 0),
+        Back::Continue(i, r) => (2, i, r),
+        Back::Jump(i, r) => (3, i, r),
+    };
+    rng::hash(&[seed, q as u64, slot as u64, tag, i as u64, r as u64])
+}
+
+/// The candidates of query sample `q`: the best exemplar samples by unary
+/// cost, plus the continuations of the previous layer's best states.
+fn candidates(
+    p: &Problem,
+    q: usize,
+    prev: Option<&Layer>,
+    lmin: usize,
+    lens: &[usize],
+) -> Vec<(usize, usize)> {
+    let o = p.opts;
+    let total: usize = lens.iter().sum();
+    let mut all: Vec<(usize, usize)> = Vec::new();
+    if o.candidates >= total {
+        for (e, &len) in lens.iter().enumerate() {
+            all.extend((0..len).map(|s| (e, s)));
+        }
+        return all;
+    }
+    let mut scored: Vec<(f64, u64, usize, usize)> = Vec::with_capacity(total);
+    for (e, &len) in lens.iter().enumerate() {
+        for s in 0..len {
+            let key = rng::hash(&[o.seed, q as u64, e as u64, s as u64]);
+            scored.push((p.unary(q, e, s), key, e, s));
+        }
+    }
+    let k = o.candidates.max(1);
+    let by = |a: &(f64, u64, usize, usize), b: &(f64, u64, usize, usize)| {
+        a.0.total_cmp(&b.0).then(a.1.cmp(&b.1))
+    };
+    if scored.len() > k {
+        scored.select_nth_unstable_by(k - 1, by);
+        scored.truncate(k);
+    }
+    scored.sort_by(by);
+    all.extend(scored.iter().map(|t| (t.2, t.3)));
+    if let Some(prev) = prev {
+        let mut best: Vec<(f64, usize)> = (0..prev.cands.len())
+            .map(|ci| {
+                let m = prev.cost[ci * lmin..(ci + 1) * lmin]
+                    .iter()
+                    .fold(f64::INFINITY, |a, &b| a.min(b));
+                (m, ci)
+            })
+            .filter(|t| t.0.is_finite())
+            .collect();
+        best.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        for &(_, ci) in best.iter().take(o.beam) {
+            let (e, s) = prev.cands[ci];
+            if s + 1 < lens[e] {
+                all.push((e, s + 1));
+            }
+        }
+    }
+    let mut seen: HashMap<(usize, usize), ()> = HashMap::with_capacity(all.len());
+    all.retain(|c| seen.insert(*c, ()).is_none());
+    all
+}
+
+/// Segments from a per-sample assignment and segment starts, extended by
+/// `overlap` samples each way as far as query and exemplar allow.
+fn segments_of(
+    assign: &[(usize, usize)],
+    starts: &[bool],
+    lens: &[usize],
+    overlap: usize,
+) -> Vec<MatchedSegment> {
+    let n = assign.len();
+    let mut out = Vec::new();
+    let mut q0 = 0;
+    for q in 1..=n {
+        if starts.get(q).copied().unwrap_or(true) {
+            let (e, s0) = assign[q0];
+            let len_e = lens.get(e).copied().unwrap_or(0);
+            let before = overlap.min(q0).min(s0);
+            let after = overlap.min(n - q).min(len_e.saturating_sub(s0 + (q - q0)));
+            out.push(MatchedSegment {
+                exemplar: e,
+                core: q0..q,
+                query: q0 - before..q + after,
+                exemplar_samples: s0 - before..s0 + (q - q0) + after,
+            });
+            q0 = q;
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+#[path = "matching_tests.rs"]
+mod tests;

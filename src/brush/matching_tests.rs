@@ -1,0 +1,237 @@
+//! Tests of the piecewise matching: the DP against exhaustive enumeration.
+
+use super::*;
+use proptest::prelude::*;
+
+fn straight(n: usize, width: f64, turning: f64) -> SpineFeatures {
+    let len = (n - 1) as f64 * 0.2 * width;
+    SpineFeatures {
+        samples: (0..n)
+            .map(|i| {
+                let d = i as f64 * 0.2 * width;
+                SampleFeature {
+                    turning,
+                    width,
+                    dist_start: d,
+                    dist_end: len - d,
+                }
+            })
+            .collect(),
+        appearance: Vec::new(),
+    }
+}
+
+/// The minimum cost over every segmentation of the query, by brute force.
+fn exhaustive(p: &Problem, q0: usize, last: Option<(usize, usize)>) -> f64 {
+    let n = p.query_len();
+    if q0 == n {
+        return 0.0;
+    }
+    let lens = p.exemplar_lens();
+    let mut best = f64::INFINITY;
+    for len in p.min_segment()..=n - q0 {
+        for (e, &le) in lens.iter().enumerate() {
+            for s0 in 0..le {
+                if s0 + len > le {
+                    break;
+                }
+                let mut c = last.map_or(0.0, |l| p.jump(l, (e, s0)));
+                for k in 0..len {
+                    c += p.unary(q0 + k, e, s0 + k);
+                }
+                c += exhaustive(p, q0 + len, Some((e, s0 + len - 1)));
+                best = best.min(c);
+            }
+        }
+    }
+    best
+}
+
+fn features(max_len: usize) -> impl Strategy<Value = SpineFeatures> {
+    (1..=max_len).prop_flat_map(|n| {
+        (
+            proptest::collection::vec((-0.3f64..0.3, 0.5f64..1.5), n),
+            proptest::collection::vec(0.0f64..1.0, n),
+        )
+            .prop_map(move |(tw, app)| {
+                let len = (n - 1) as f64 * 0.25;
+                SpineFeatures {
+                    samples: tw
+                        .iter()
+                        .enumerate()
+                        .map(|(i, &(t, w))| SampleFeature {
+                            turning: t,
+                            width: w,
+                            dist_start: i as f64 * 0.25,
+                            dist_end: len - i as f64 * 0.25,
+                        })
+                        .collect(),
+                    appearance: app.iter().map(|&a| vec![a]).collect(),
+                }
+            })
+    })
+}
+
+fn core_cost(p: &Problem, m: &Matching) -> f64 {
+    let segs: Vec<_> = m
+        .segments
+        .iter()
+        .map(|s| {
+            let s0 = s.exemplar_samples.start + (s.core.start - s.query.start);
+            (s.exemplar, s0, s.core.clone())
+        })
+        .collect();
+    p.cost_of(&segs)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+
+    #[test]
+    fn dp_equals_exhaustive_search(
+        query in features(6),
+        exemplars in proptest::collection::vec(features(5), 1..=3),
+        min_segment in 1usize..=3,
+        seed in 0u64..4,
+    ) {
+        let opts = MatchOptions {
+            candidates: usize::MAX,
+            min_segment,
+            end_zone: 0.3,
+            end_horizon: 1.0,
+            seed,
+            ..MatchOptions::default()
+        };
+        let p = Problem::new(&query, &exemplars, &opts).unwrap();
+        let brute = exhaustive(&p, 0, None);
+        match match_query(&query, &exemplars, &opts) {
+            Ok(m) => {
+                prop_assert!((m.cost - brute).abs() <= 1e-7 * (1.0 + brute), "{} vs {}", m.cost, brute);
+                // The returned segmentation really costs that much.
+                prop_assert!((core_cost(&p, &m) - m.cost).abs() <= 1e-7 * (1.0 + brute));
+                // Cores tile the query; each is long enough and fits its exemplar.
+                let mut q = 0;
+                for s in &m.segments {
+                    prop_assert_eq!(s.core.start, q);
+                    prop_assert!(s.core.len() >= p.min_segment());
+                    prop_assert_eq!(s.query.len(), s.exemplar_samples.len());
+                    prop_assert!(s.exemplar_samples.end <= exemplars[s.exemplar].samples.len());
+                    q = s.core.end;
+                }
+                prop_assert_eq!(q, query.samples.len());
+            }
+            Err(_) => prop_assert!(brute.is_infinite()),
+        }
+    }
+
+    #[test]
+    fn pruned_dp_is_feasible_and_never_below_the_optimum(
+        query in features(8),
+        exemplars in proptest::collection::vec(features(6), 1..=3),
+    ) {
+        let exact = MatchOptions { candidates: usize::MAX, min_segment: 2, ..MatchOptions::default() };
+        let pruned = MatchOptions { candidates: 3, beam: 2, ..exact.clone() };
+        let p = Problem::new(&query, &exemplars, &pruned).unwrap();
+        if let (Ok(a), Ok(b)) = (match_query(&query, &exemplars, &exact), match_query(&query, &exemplars, &pruned)) {
+            prop_assert!(b.cost >= a.cost - 1e-9 * (1.0 + a.cost));
+            prop_assert!((core_cost(&p, &b) - b.cost).abs() <= 1e-7 * (1.0 + b.cost));
+        }
+    }
+}
+
+#[test]
+fn query_ends_take_exemplar_ends() {
+    // A 30-sample query and a 40-sample exemplar: one segment would cut an
+    // end short, so the matching takes the exemplar's start and its end.
+    let q = straight(30, 1.0, 0.0);
+    let ex = [straight(40, 1.0, 0.0)];
+    let m = match_query(&q, &ex, &MatchOptions::default()).unwrap();
+    assert!(m.segments.len() >= 2, "{:?}", m.segments);
+    let first = &m.segments[0];
+    let last = &m.segments[m.segments.len() - 1];
+    assert_eq!(first.exemplar_samples.start, 0);
+    assert_eq!(last.exemplar_samples.end, 40);
+    assert!(m.cost < 10.0, "no end penalty paid: {}", m.cost);
+    // Neighbours overlap by the extension.
+    for w in m.segments.windows(2) {
+        assert!(w[0].query.end > w[1].query.start);
+        assert_eq!(w[0].core.end, w[1].core.start);
+    }
+}
+
+#[test]
+fn long_query_is_covered_by_several_segments() {
+    let q = straight(200, 1.0, 0.01);
+    let ex: Vec<_> = (0..10)
+        .map(|i| straight(100, 1.0, 0.002 * i as f64))
+        .collect();
+    let m = match_query(&q, &ex, &MatchOptions::default()).unwrap();
+    assert!(m.segments.len() >= 3);
+    assert_eq!(m.segments[0].exemplar_samples.start, 0);
+    let last = &m.segments[m.segments.len() - 1];
+    assert_eq!(last.exemplar_samples.end, 100);
+    // The exemplar whose turning matches (0.01 = 0.002 × 5) dominates.
+    let owned: usize = m
+        .segments
+        .iter()
+        .filter(|s| s.exemplar == 5)
+        .map(|s| s.core.len())
+        .sum();
+    assert!(owned > 150, "{:?}", m.segments);
+}
+
+#[test]
+fn seed_breaks_ties_between_identical_exemplars() {
+    let q = straight(20, 1.0, 0.0);
+    let ex = [straight(20, 1.0, 0.0), straight(20, 1.0, 0.0)];
+    let pick = |seed| {
+        let opts = MatchOptions {
+            seed,
+            ..MatchOptions::default()
+        };
+        match_query(&q, &ex, &opts).unwrap()
+    };
+    let picks: Vec<usize> = (0..16).map(|s| pick(s).segments[0].exemplar).collect();
+    assert!(picks.contains(&0) && picks.contains(&1), "{picks:?}");
+    assert_eq!(pick(3), pick(3));
+    assert_eq!(pick(3).segments.len(), 1);
+}
+
+#[test]
+fn jumps_prefer_look_alike_boundaries() {
+    // Two exemplar families: appearance 0 and appearance 1. A boundary
+    // between families pays w_appearance, so the query stays in one family.
+    let q = straight(60, 1.0, 0.0);
+    let with_app = |a: f64| {
+        let mut f = straight(35, 1.0, 0.0);
+        f.appearance = vec![vec![a]; 35];
+        f
+    };
+    let ex = [with_app(0.0), with_app(1.0), with_app(0.0)];
+    let m = match_query(&q, &ex, &MatchOptions::default()).unwrap();
+    let fam = |e: usize| ex[e].appearance[0][0];
+    for w in m.segments.windows(2) {
+        assert_eq!(fam(w[0].exemplar), fam(w[1].exemplar), "{:?}", m.segments);
+    }
+}
+
+#[test]
+fn bad_inputs_are_errors() {
+    let q = straight(5, 1.0, 0.0);
+    let empty = SpineFeatures {
+        samples: vec![],
+        appearance: vec![],
+    };
+    let opts = MatchOptions::default();
+    assert!(match_query(&empty, std::slice::from_ref(&q), &opts).is_err());
+    assert!(match_query(&q, std::slice::from_ref(&empty), &opts).is_err());
+    let mut nan = q.clone();
+    nan.samples[2].turning = f64::NAN;
+    assert!(match_query(&q, &[nan], &opts).is_err());
+    // Exemplars shorter than the shortest segment cannot cover the query.
+    let opts = MatchOptions {
+        min_segment: 4,
+        ..MatchOptions::default()
+    };
+    assert!(match_query(&q, &[straight(3, 1.0, 0.0)], &opts).is_err());
+}
