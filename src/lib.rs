@@ -22,6 +22,7 @@ pub mod render;
 pub mod sketch;
 pub mod style;
 pub mod svg_out;
+pub mod synth;
 pub mod trace;
 
 pub use error::{Error, Result};

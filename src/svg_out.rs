@@ -11,7 +11,9 @@ use kurbo::{BezPath, PathEl, Point, Rect};
 use std::fmt::Write as _;
 
 /// An sRGB colour, 8 bits per channel.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize,
+)]
 pub struct Color {
     /// Red, 0–255.
     pub r: u8,

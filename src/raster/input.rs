@@ -75,7 +75,8 @@ pub fn load(path: &Path, opts: &InputOptions) -> Result<Ink> {
     }
 }
 
-fn looks_like_svg(bytes: &[u8]) -> bool {
+/// Whether `bytes` look like SVG (text starting with `<`, or gzip: SVGZ).
+pub fn looks_like_svg(bytes: &[u8]) -> bool {
     let head = &bytes[..bytes.len().min(512)];
     let text = String::from_utf8_lossy(head);
     let t = text.trim_start_matches('\u{feff}').trim_start();
@@ -110,7 +111,8 @@ pub fn decode_raster(path: &Path, bytes: &[u8]) -> Result<image::DynamicImage> {
     reader.decode().map_err(|e| bad(&e))
 }
 
-fn load_raster(path: &Path, bytes: &[u8], opts: &InputOptions) -> Result<Ink> {
+/// Raster bytes (PNG, JPEG, …) read from `path` as ink, as [`load`] reads them.
+pub fn load_raster(path: &Path, bytes: &[u8], opts: &InputOptions) -> Result<Ink> {
     let img = decode_raster(path, bytes)?.to_rgba8();
     let (w, h) = (img.width() as usize, img.height() as usize);
     let has_alpha = img.pixels().any(|p| p[3] < 255);
@@ -342,10 +344,16 @@ fn paint_colour(paint: &usvg::Paint) -> Color {
     Color::rgb(c.red, c.green, c.blue)
 }
 
-fn collect_shapes(group: &usvg::Group, canvas: tiny_skia::Transform, out: &mut Vec<SvgShape>) {
+fn collect_shapes(
+    group: &usvg::Group,
+    canvas: tiny_skia::Transform,
+    skip_id: Option<&str>,
+    out: &mut Vec<SvgShape>,
+) {
     for node in group.children() {
         match node {
-            usvg::Node::Group(g) => collect_shapes(g, canvas, out),
+            usvg::Node::Group(g) => collect_shapes(g, canvas, skip_id, out),
+            usvg::Node::Path(p) if skip_id.is_some_and(|id| p.id() == id) => {}
             usvg::Node::Path(p) if p.is_visible() => {
                 let transform = p.abs_transform().post_concat(canvas);
                 if let Some(fill) = p.fill() {
@@ -604,6 +612,18 @@ fn overlaps(a: kurbo::Rect, b: kurbo::Rect) -> bool {
 
 fn load_svg(path: &Path, bytes: &[u8], opts: &InputOptions) -> Result<Ink> {
     let tree = io::parse_svg(path, bytes)?;
+    svg_ink(path, &tree, opts, None)
+}
+
+/// The ink of a parsed SVG `tree` (read from `path`, named in errors) as
+/// [`load`] reads SVG files; paths whose `id` is `skip_id` are left out
+/// (a brush exemplar's hand-drawn `id="spine"` is not ink).
+pub fn svg_ink(
+    path: &Path,
+    tree: &usvg::Tree,
+    opts: &InputOptions,
+    skip_id: Option<&str>,
+) -> Result<Ink> {
     let size = tree.size();
     let (uw, uh) = (size.width() as f64, size.height() as f64);
     if opts.resolution == 0 {
@@ -618,7 +638,7 @@ fn load_svg(path: &Path, bytes: &[u8], opts: &InputOptions) -> Result<Ink> {
     let (pw, ph) = (pw.max(1) as usize, ph.max(1) as usize);
     let canvas = tiny_skia::Transform::from_scale(scale as f32, scale as f32);
     let mut shapes = Vec::new();
-    collect_shapes(tree.root(), canvas, &mut shapes);
+    collect_shapes(tree.root(), canvas, skip_id, &mut shapes);
     // Colours in order of first appearance: the stacking order.
     let mut colours: Vec<Color> = Vec::new();
     for s in &shapes {

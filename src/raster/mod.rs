@@ -4,6 +4,7 @@
 
 pub mod edt;
 pub mod input;
+pub mod plain;
 pub mod sdf;
 
 pub use sdf::Sdf;

@@ -1,10 +1,22 @@
 //! Style libraries: a folder holding `style.toml` and its exemplar files.
 //!
 //! This module reads and validates `style.toml` ([`StyleToml`]) and finds a
-//! style folder from a `--style` argument ([`resolve`]). The analysis of the
-//! exemplars belongs to each mode (`pattern::PatternStyle` for patterns).
+//! style folder from a `--style` argument ([`resolve`]). Brush libraries are
+//! analysed here, stage by stage: [`exemplar`] (loading, pyramid, SDF
+//! layers), [`spine`] (main branch), [`uv`] (ribs and per-pixel
+//! orientation), the neighbourhood index ([`crate::synth::neighbourhood`]),
+//! [`cache`], and [`check`] (report and diagnostics sheet); [`brush`] ties
+//! them together ([`brush::BrushStyle::load`]). Pattern styles are analysed
+//! by `pattern::PatternStyle`.
 //!
 //! Every error names the `style.toml` file and, where there is one, the key.
+
+pub mod brush;
+pub mod cache;
+pub mod check;
+pub mod exemplar;
+pub mod spine;
+pub mod uv;
 
 use crate::error::{Error, Result};
 use serde::Deserialize;
@@ -163,6 +175,42 @@ impl StyleToml {
                         ex.file.display()
                     ),
                 );
+            }
+        }
+        if self.kind == StyleKind::Brush {
+            if self.exemplar.is_empty() {
+                return bad(
+                    "exemplar",
+                    "a brush style needs at least one [[exemplar]] table".into(),
+                );
+            }
+            for (i, ex) in self.exemplar.iter().enumerate() {
+                for (key, p) in [("start", ex.start), ("end", ex.end)] {
+                    if let Some([x, y]) = p {
+                        if !(x.is_finite() && y.is_finite()) {
+                            return bad(
+                                &format!("exemplar[{i}].{key}"),
+                                format!("must be two finite numbers, got [{x}, {y}]"),
+                            );
+                        }
+                    }
+                }
+                match (ex.start, ex.end) {
+                    (Some(a), Some(b)) if a == b => {
+                        return bad(
+                            &format!("exemplar[{i}].end"),
+                            format!("equals start [{}, {}]; the spine needs two ends", a[0], a[1]),
+                        );
+                    }
+                    (Some(_), None) | (None, Some(_)) => {
+                        let missing = if ex.start.is_none() { "start" } else { "end" };
+                        return bad(
+                            &format!("exemplar[{i}].{missing}"),
+                            "missing; give both start and end (or neither, with a path id=\"spine\" in the exemplar)".into(),
+                        );
+                    }
+                    _ => {}
+                }
             }
         }
         if self.kind == StyleKind::Pattern {

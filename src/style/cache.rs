@@ -1,0 +1,134 @@
+//! The analysis cache: a brush style's analysis stored in one file, keyed
+//! by a content hash, reused while nothing changed.
+//!
+//! * Key: blake3 of [`ANALYSIS_VERSION`], `style.toml` and every exemplar
+//!   file (name and bytes, in `style.toml` order). Editing any of them, or
+//!   a new analysis version, gives a new key and a new file.
+//! * File: `NAME-KEY.bin` in the cache folder: a magic tag, the version,
+//!   the full key, then the analysis in postcard with grids as byte
+//!   strings ([`crate::raster::plain`]) so it loads at memory speed.
+//! * Folder: [`AnalysisOptions::cache_dir`](super::brush::AnalysisOptions)
+//!   (`--cache DIR`), else `$FLOURISH_CACHE_DIR`, else the platform's cache
+//!   folder (`~/.cache/flourish/styles` on Linux).
+//! * A file that is missing, of another version or key, truncated, corrupt
+//!   or inconsistent (sizes that disagree, see
+//!   [`super::brush::BrushStyle::validate`]) is never trusted: the style is
+//!   analysed again and the file rewritten atomically. Failing to write the
+//!   cache (read-only folder) is not an error.
+
+use super::brush::BrushStyle;
+use crate::error::Result;
+use crate::io;
+use std::path::{Path, PathBuf};
+
+/// Version of the analysis; bump it whenever the analysis or the cached
+/// types change so old caches are rebuilt.
+pub const ANALYSIS_VERSION: u32 = 1;
+
+/// Environment variable naming the cache folder (below `--cache`).
+pub const CACHE_ENV: &str = "FLOURISH_CACHE_DIR";
+
+const MAGIC: &[u8; 8] = b"FLRSHBRU";
+
+/// What happened to the cache on a load.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CacheStatus {
+    /// A valid cache file was used.
+    Hit,
+    /// There was no cache file for this content: analysed and stored.
+    Miss,
+    /// A cache file was there but unusable (corrupt, truncated,
+    /// inconsistent): analysed and rewritten.
+    Rebuilt,
+    /// Caching is off or no cache folder could be found: analysed.
+    Disabled,
+}
+
+/// The cache folder: `explicit`, else `$FLOURISH_CACHE_DIR`, else the
+/// platform cache folder; `None` when none can be found.
+pub fn cache_dir(explicit: Option<&Path>) -> Option<PathBuf> {
+    if let Some(d) = explicit {
+        return Some(d.to_path_buf());
+    }
+    if let Some(d) = std::env::var_os(CACHE_ENV).filter(|d| !d.is_empty()) {
+        return Some(PathBuf::from(d));
+    }
+    directories::ProjectDirs::from("", "", "flourish").map(|p| p.cache_dir().join("styles"))
+}
+
+/// The content key of a style: `style.toml`'s bytes and each exemplar's
+/// name and bytes, with the analysis version. Reading an exemplar fails
+/// with the file's own error (e.g. a missing exemplar).
+pub fn style_key(toml_bytes: &[u8], exemplars: &[PathBuf]) -> Result<[u8; 32]> {
+    let mut h = blake3::Hasher::new();
+    h.update(MAGIC);
+    h.update(&ANALYSIS_VERSION.to_le_bytes());
+    h.update(&(toml_bytes.len() as u64).to_le_bytes());
+    h.update(toml_bytes);
+    for p in exemplars {
+        let bytes = io::read_file(p)?;
+        let name = p.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        h.update(&(name.len() as u64).to_le_bytes());
+        h.update(name.as_bytes());
+        h.update(&(bytes.len() as u64).to_le_bytes());
+        h.update(&bytes);
+    }
+    Ok(*h.finalize().as_bytes())
+}
+
+/// The cache file of style `name` with content `key` in `dir`.
+pub fn cache_file(dir: &Path, name: &str, key: &[u8; 32]) -> PathBuf {
+    let safe: String = name
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' })
+        .collect();
+    let hex: String = key[..12].iter().map(|b| format!("{b:02x}")).collect();
+    dir.join(format!("{safe}-{hex}.bin"))
+}
+
+/// Outcome of reading a cache file.
+pub enum Read {
+    /// No file.
+    Missing,
+    /// A file that cannot be trusted.
+    Unusable,
+    /// The stored analysis.
+    Found(Box<BrushStyle>),
+}
+
+/// Reads the analysis stored in `path` for `key`, checking tag, version,
+/// key, decoding and consistency.
+pub fn read(path: &Path, key: &[u8; 32]) -> Read {
+    let bytes = match std::fs::read(path) {
+        Ok(b) => b,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Read::Missing,
+        Err(_) => return Read::Unusable,
+    };
+    let head = MAGIC.len() + 4 + 32;
+    if bytes.len() < head
+        || &bytes[..8] != MAGIC
+        || bytes[8..12] != ANALYSIS_VERSION.to_le_bytes()
+        || &bytes[12..44] != key
+    {
+        return Read::Unusable;
+    }
+    match postcard::from_bytes::<BrushStyle>(&bytes[head..]) {
+        Ok(style) if style.validate() => Read::Found(Box::new(style)),
+        _ => Read::Unusable,
+    }
+}
+
+/// Writes `style` for `key` to `path` atomically (creating the folder).
+pub fn write(path: &Path, key: &[u8; 32], style: &BrushStyle) -> Result<()> {
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| crate::Error::io(dir, e))?;
+    }
+    let mut bytes = Vec::with_capacity(1 << 20);
+    bytes.extend_from_slice(MAGIC);
+    bytes.extend_from_slice(&ANALYSIS_VERSION.to_le_bytes());
+    bytes.extend_from_slice(key);
+    let body = postcard::to_stdvec(style)
+        .map_err(|e| crate::Error::invalid(path, format!("cannot encode the analysis: {e}")))?;
+    bytes.extend_from_slice(&body);
+    io::write_atomic(path, &bytes)
+}

@@ -1,0 +1,1 @@
+//! `flourish style check`: placeholder replaced below.
