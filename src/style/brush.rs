@@ -163,7 +163,10 @@ impl BrushStyle {
     }
 
     /// [`BrushStyle::load`], also telling what the cache did.
-    pub fn load_with_status(dir: &Path, opts: &AnalysisOptions) -> Result<(BrushStyle, CacheStatus)> {
+    pub fn load_with_status(
+        dir: &Path,
+        opts: &AnalysisOptions,
+    ) -> Result<(BrushStyle, CacheStatus)> {
         let toml_path = dir.join(STYLE_FILE);
         let toml_bytes = crate::io::read_file(&toml_path)?;
         let text = String::from_utf8(toml_bytes.clone())
@@ -205,7 +208,10 @@ impl BrushStyle {
                     let (w, h) = (l.width(), l.height());
                     let same = |g_w: usize, g_h: usize| g_w == w && g_h == h;
                     l.scale.is_finite()
-                        && l.ink.layers.iter().all(|ly| same(ly.sdf.width(), ly.sdf.height()))
+                        && l.ink
+                            .layers
+                            .iter()
+                            .all(|ly| same(ly.sdf.width(), ly.sdf.height()))
                         && same(l.orientation.dir.width(), l.orientation.dir.height())
                         && same(l.orientation.mask.width(), l.orientation.mask.height())
                 })
@@ -219,7 +225,9 @@ impl BrushStyle {
                         self.exemplars
                             .get(r.exemplar as usize)
                             .and_then(|e| e.levels.get(l))
-                            .is_some_and(|lv| (r.x as usize) < lv.width() && (r.y as usize) < lv.height())
+                            .is_some_and(|lv| {
+                                (r.x as usize) < lv.width() && (r.y as usize) < lv.height()
+                            })
                     })
             });
         ok_ex && ok_idx && !self.exemplars.is_empty()
@@ -234,7 +242,10 @@ impl BrushStyle {
             return None;
         }
         let up = lv.orientation.dir.get(x, y);
-        Some(self.sampler.sample(&lv.ink.ink, [x as f64 + 0.5, y as f64 + 0.5], up))
+        Some(
+            self.sampler
+                .sample(&lv.ink.ink, [x as f64 + 0.5, y as f64 + 0.5], up),
+        )
     }
 }
 
@@ -247,7 +258,12 @@ fn style_name(dir: &Path) -> String {
 }
 
 /// Analyses every exemplar of `toml` (from folder `dir`) and indexes them.
-pub fn analyse(dir: &Path, name: &str, toml: &StyleToml, opts: &AnalysisOptions) -> Result<BrushStyle> {
+pub fn analyse(
+    dir: &Path,
+    name: &str,
+    toml: &StyleToml,
+    opts: &AnalysisOptions,
+) -> Result<BrushStyle> {
     let resolution = toml.resolution.unwrap_or(DEFAULT_RESOLUTION);
     let sdf = toml.sdf.unwrap_or(true);
     let sampler = NeighbourhoodSampler {
@@ -388,12 +404,21 @@ fn analyse_exemplar(
     let mut hoods = Vec::with_capacity(LEVELS);
     for lv in ink.levels {
         let scale = lv.px_per_unit / fine_ppu;
-        let field = uv::orientation_field(&ribs.scaled(scale), lv.ink.width(), lv.ink.height(), REGION_MARGIN);
+        let field = uv::orientation_field(
+            &ribs.scaled(scale),
+            lv.ink.width(),
+            lv.ink.height(),
+            REGION_MARGIN,
+        );
         let mut v = Vec::new();
         for y in 0..field.mask.height() {
             for x in 0..field.mask.width() {
                 if field.mask.get(x, y) {
-                    v.push(sampler.sample(&lv.ink, [x as f64 + 0.5, y as f64 + 0.5], field.dir.get(x, y)));
+                    v.push(sampler.sample(
+                        &lv.ink,
+                        [x as f64 + 0.5, y as f64 + 0.5],
+                        field.dir.get(x, y),
+                    ));
                 }
             }
         }

@@ -67,7 +67,10 @@ pub fn style_key(toml_bytes: &[u8], exemplars: &[PathBuf]) -> Result<[u8; 32]> {
     h.update(toml_bytes);
     for p in exemplars {
         let bytes = io::read_file(p)?;
-        let name = p.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        let name = p
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
         h.update(&(name.len() as u64).to_le_bytes());
         h.update(name.as_bytes());
         h.update(&(bytes.len() as u64).to_le_bytes());
@@ -80,7 +83,13 @@ pub fn style_key(toml_bytes: &[u8], exemplars: &[PathBuf]) -> Result<[u8; 32]> {
 pub fn cache_file(dir: &Path, name: &str, key: &[u8; 32]) -> PathBuf {
     let safe: String = name
         .chars()
-        .map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '_' { c } else { '_' })
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
         .collect();
     let hex: String = key[..12].iter().map(|b| format!("{b:02x}")).collect();
     dir.join(format!("{safe}-{hex}.bin"))

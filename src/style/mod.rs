@@ -199,7 +199,10 @@ impl StyleToml {
                     (Some(a), Some(b)) if a == b => {
                         return bad(
                             &format!("exemplar[{i}].end"),
-                            format!("equals start [{}, {}]; the spine needs two ends", a[0], a[1]),
+                            format!(
+                                "equals start [{}, {}]; the spine needs two ends",
+                                a[0], a[1]
+                            ),
                         );
                     }
                     (Some(_), None) | (None, Some(_)) => {

@@ -160,7 +160,8 @@ pub fn shortest_path(
             let there = unit(flow_at(flow, nx as f64 + 0.5, ny as f64 + 0.5));
             let f = dir.dot(mid).abs();
             let c = here.dot(there).abs();
-            let cost = len + opts.w_flow * (1.0 - f.powi(opts.power)) + opts.w_curvature * (1.0 - c);
+            let cost =
+                len + opts.w_flow * (1.0 - f.powi(opts.power)) + opts.w_curvature * (1.0 - c);
             let nd = d + cost;
             if nd < dist[j] {
                 dist[j] = nd;
@@ -315,10 +316,7 @@ mod tests {
     fn there_are_32_link_directions_spread_around_the_circle() {
         let l = link_offsets();
         assert_eq!(l.len(), 32);
-        let mut angles: Vec<f64> = l
-            .iter()
-            .map(|&(x, y)| (y as f64).atan2(x as f64))
-            .collect();
+        let mut angles: Vec<f64> = l.iter().map(|&(x, y)| (y as f64).atan2(x as f64)).collect();
         angles.sort_by(f64::total_cmp);
         let gaps: Vec<f64> = angles.windows(2).map(|w| w[1] - w[0]).collect();
         let max_gap = gaps.iter().cloned().fold(0.0, f64::max);
@@ -373,13 +371,8 @@ mod tests {
             })
             .collect();
         let sdf = band_sdf(128, &centre, 6.0);
-        let (path, fit) = trace_spine(
-            &sdf,
-            centre[2],
-            centre[98],
-            &SpineOptions::default(),
-        )
-        .unwrap();
+        let (path, fit) =
+            trace_spine(&sdf, centre[2], centre[98], &SpineOptions::default()).unwrap();
         // The raw path stays in the band, the fit near its centre line, and
         // the fit really is an S: above the middle first, then below.
         for p in &path {
@@ -417,7 +410,11 @@ mod tests {
         let truth = Quartic {
             start: Point::new(0.0, 0.0),
             end: Point::new(100.0, 10.0),
-            coeffs: [Vec2::new(0.0, 40.0), Vec2::new(0.0, 20.0), Vec2::new(0.0, -60.0)],
+            coeffs: [
+                Vec2::new(0.0, 40.0),
+                Vec2::new(0.0, 20.0),
+                Vec2::new(0.0, -60.0),
+            ],
         };
         // Sample at chord-length-uniform parameters so the fit's `t` agrees.
         let dense = truth.polyline(4000);

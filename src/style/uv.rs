@@ -62,7 +62,10 @@ impl Ribs {
     /// Rib lengths `|l̂_i − r̂_i|` through the spine (local widths), px.
     pub fn widths(&self) -> Vec<f64> {
         (0..self.len())
-            .map(|i| pt(self.left[i]).distance(pt(self.spine[i])) + pt(self.right[i]).distance(pt(self.spine[i])))
+            .map(|i| {
+                pt(self.left[i]).distance(pt(self.spine[i]))
+                    + pt(self.right[i]).distance(pt(self.spine[i]))
+            })
             .collect()
     }
 }
@@ -312,7 +315,11 @@ pub fn orientation_field(ribs: &Ribs, w: usize, h: usize, margin: f64) -> Orient
     let xs: Vec<Point> = ribs.spine.iter().map(|&p| pt(p)).collect();
     let spine_dir: Vec<Vec2> = (0..n)
         .map(|i| {
-            let d = if i == 0 { xs[1] - xs[0] } else { xs[i] - xs[i - 1] };
+            let d = if i == 0 {
+                xs[1] - xs[0]
+            } else {
+                xs[i] - xs[i - 1]
+            };
             let l = d.hypot();
             if l > 0.0 {
                 d / l
@@ -482,6 +489,9 @@ mod tests {
         assert_eq!(sample_count(10.0, 0.25), 30);
         assert_eq!(sample_count(400.0 * 4.0, 0.25), 100);
         assert_eq!(sample_count(f64::NAN, 0.25), 30);
-        assert_eq!(resample(&[Point::new(0.0, 0.0), Point::new(10.0, 0.0)], 3)[1], Point::new(5.0, 0.0));
+        assert_eq!(
+            resample(&[Point::new(0.0, 0.0), Point::new(10.0, 0.0)], 3)[1],
+            Point::new(5.0, 0.0)
+        );
     }
 }

@@ -155,7 +155,11 @@ impl Pca {
         }
         let eig = nalgebra::SymmetricEigen::new(cov);
         let mut order: Vec<usize> = (0..SIZE).collect();
-        order.sort_by(|&a, &b| eig.eigenvalues[b].total_cmp(&eig.eigenvalues[a]).then(a.cmp(&b)));
+        order.sort_by(|&a, &b| {
+            eig.eigenvalues[b]
+                .total_cmp(&eig.eigenvalues[a])
+                .then(a.cmp(&b))
+        });
         let mut axes = Vec::with_capacity(PCA_DIMS);
         let mut variances = Vec::with_capacity(PCA_DIMS);
         for &k in order.iter().take(PCA_DIMS) {
@@ -256,7 +260,10 @@ impl NeighbourhoodIndex {
     pub fn nearest(&self, query: &Neighbourhood) -> Option<(NeighbourhoodRef, f32)> {
         let q = self.pca.project(query);
         let tree = self.tree()?;
-        let found = tree.query(&q).nearest_one::<SquaredEuclidean<f32>>().execute();
+        let found = tree
+            .query(&q)
+            .nearest_one::<SquaredEuclidean<f32>>()
+            .execute();
         let r = self.refs.get(found.item as usize)?;
         Some((*r, found.distance))
     }
@@ -302,14 +309,26 @@ mod tests {
         for a in [0.4f64, 1.3, 2.9, -2.2] {
             let rot = ell(64, c, a);
             let (sn, cs) = a.sin_cos();
-            for (p, up) in [([32.0, 30.0], [0.0f64, -1.0]), ([38.0, 27.0], [0.6, -0.8]), ([27.0, 33.0], [1.0, 0.0])] {
+            for (p, up) in [
+                ([32.0, 30.0], [0.0f64, -1.0]),
+                ([38.0, 27.0], [0.6, -0.8]),
+                ([27.0, 33.0], [1.0, 0.0]),
+            ] {
                 let (dx, dy) = (p[0] - c[0], p[1] - c[1]);
                 let q = [c[0] + cs * dx - sn * dy, c[1] + sn * dx + cs * dy];
-                let rup = [(cs * up[0] - sn * up[1]) as f32, (sn * up[0] + cs * up[1]) as f32];
+                let rup = [
+                    (cs * up[0] - sn * up[1]) as f32,
+                    (sn * up[0] + cs * up[1]) as f32,
+                ];
                 let n0 = s.sample(&base, p, [up[0] as f32, up[1] as f32]);
                 let n1 = s.sample(&rot, q, rup);
                 for k in 0..SIZE {
-                    assert!((n0[k] - n1[k]).abs() < 0.1, "a={a} k={k}: {} vs {}", n0[k], n1[k]);
+                    assert!(
+                        (n0[k] - n1[k]).abs() < 0.1,
+                        "a={a} k={k}: {} vs {}",
+                        n0[k],
+                        n1[k]
+                    );
                 }
                 // And an unrotated sampling of the rotated image differs.
                 let wrong = s.sample(&rot, q, [up[0] as f32, up[1] as f32]);
@@ -341,7 +360,9 @@ mod tests {
         // brute-force scan over the projections.
         let mut state = 12345u64;
         let mut rnd = || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             ((state >> 33) as f32 / (1u64 << 31) as f32) - 0.5
         };
         let data: Vec<Neighbourhood> = (0..500)
