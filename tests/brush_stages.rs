@@ -7,7 +7,7 @@
 //! `$TMPDIR/flourish-brush-stages.png` for a look.
 
 use flourish::brush::arap::{mean_distortion, rasterize_coords, Arap, RibMesh};
-use flourish::brush::graphcut::{seam, Cover, Label, SeamParams};
+use flourish::brush::graphcut::{overlap_cover, seam, Cover, Label, SeamParams};
 use flourish::brush::matching::{match_query, MatchOptions, SpineFeatures};
 use flourish::brush::query::{self, QueryOptions, QuerySpine};
 use flourish::raster::Grid;
@@ -95,19 +95,8 @@ impl Exemplar {
     }
 
     fn features(&self) -> SpineFeatures {
-        let len = query::polyline_length(&self.spine);
-        let samples = query::features(&self.spine, 2.0 * HALF, len);
-        let mut f = SpineFeatures::from_query(&QuerySpine {
-            query_id: String::new(),
-            subpath: 0,
-            style: None,
-            width: 2.0 * HALF,
-            spacing: SPACING,
-            length: len,
-            samples,
-        });
         // Appearance: mean ink across each rib.
-        f.appearance = (0..self.spine.len())
+        let appearance = (0..self.spine.len())
             .map(|i| {
                 let ink: f32 = (0..=10)
                     .map(|k| self.ink(self.right[i].lerp(self.left[i], k as f64 / 10.0)))
@@ -115,7 +104,7 @@ impl Exemplar {
                 vec![ink as f64 / 11.0]
             })
             .collect();
-        f
+        SpineFeatures::from_ribs(&self.spine, &self.left, &self.right, appearance).expect("ribs")
     }
 }
 
@@ -189,35 +178,10 @@ fn run(seed: u64) -> (QuerySpine, Vec<Exemplar>, Fields, Grid<f32>) {
         }
     }
     for k in 0..fields.len() - 1 {
-        let both = |x: usize, y: usize| {
-            fields[k].1.get(x, y).is_some() && fields[k + 1].1.get(x, y).is_some()
-        };
-        // The overlap's bounding box, 2 px wider: it holds the overlap and
-        // the single-covered pixels next to it.
-        let (mut x0, mut y0, mut x1, mut y1) = (usize::MAX, usize::MAX, 0, 0);
-        for y in 0..h {
-            for x in 0..w {
-                if both(x, y) {
-                    (x0, y0, x1, y1) = (x0.min(x), y0.min(y), x1.max(x), y1.max(y));
-                }
-            }
-        }
-        assert!(x0 <= x1, "segments {k} and {} overlap", k + 1);
-        let (x0, y0) = (x0.saturating_sub(2), y0.saturating_sub(2));
-        let (x1, y1) = ((x1 + 2).min(w - 1), (y1 + 2).min(h - 1));
-        let (cw, ch) = (x1 - x0 + 1, y1 - y0 + 1);
-        let cover = Grid::from_fn(cw, ch, |x, y| {
-            let (x, y) = (x + x0, y + y0);
-            match (
-                fields[k].1.get(x, y).is_some(),
-                fields[k + 1].1.get(x, y).is_some(),
-            ) {
-                (true, true) => Cover::Both,
-                (true, false) => Cover::A,
-                (false, true) => Cover::B,
-                (false, false) => Cover::None,
-            }
-        });
+        let covers = |k: usize| fields[k].1.map(|c| c.is_some());
+        let (x0, y0, cover) =
+            overlap_cover(&covers(k), &covers(k + 1), 2).expect("consecutive segments overlap");
+        let (cw, ch) = (cover.width(), cover.height());
         let a = Grid::from_fn(cw, ch, |x, y| ink_of(k, x + x0, y + y0).unwrap_or(1.0));
         let b = Grid::from_fn(cw, ch, |x, y| ink_of(k + 1, x + x0, y + y0).unwrap_or(1.0));
         let s = seam(&a, &b, &cover, &params).expect("cuts");

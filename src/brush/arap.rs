@@ -394,10 +394,19 @@ fn fit_matrix(x: f64, y: f64) -> Matrix6x4<f64> {
 }
 
 /// The singular values (σ1 ≥ σ2) of the deformation gradient of triangle
-/// `tri` from `rest` to `deformed` positions.
+/// `tri` from `rest` to `deformed` positions (`(∞, 0)` for a degenerate
+/// or out-of-range triangle).
 pub fn triangle_stretches(rest: &[Point], deformed: &[Point], tri: [usize; 3]) -> (f64, f64) {
-    let [a, b, c] = tri.map(|v| rest[v]);
-    let [p, q, r] = tri.map(|v| deformed[v]);
+    let (Some(a), Some(b), Some(c), Some(p), Some(q), Some(r)) = (
+        rest.get(tri[0]),
+        rest.get(tri[1]),
+        rest.get(tri[2]),
+        deformed.get(tri[0]),
+        deformed.get(tri[1]),
+        deformed.get(tri[2]),
+    ) else {
+        return (f64::INFINITY, 0.0);
+    };
     let d = Matrix2::new(b.x - a.x, c.x - a.x, b.y - a.y, c.y - a.y);
     let e = Matrix2::new(q.x - p.x, r.x - p.x, q.y - p.y, r.y - p.y);
     let Some(dinv) = d.try_inverse() else {

@@ -91,6 +91,10 @@ pub fn art_brush_positions(
     if spine.len() < 2 || spine.len() != mesh.spine.len() {
         return bad("the exemplar mesh has fewer than two ribs");
     }
+    let per = mesh.per_rib;
+    if per == 0 || mesh.rest.len() != per * spine.len() {
+        return bad("the mesh is not a rib mesh (vertex count ≠ ribs × per_rib)");
+    }
     if query.len() < 2 || !query.iter().all(|p| p.x.is_finite() && p.y.is_finite()) {
         return bad("the query needs at least two finite points");
     }
@@ -104,7 +108,6 @@ pub fn art_brush_positions(
         return bad("a spine has zero length");
     }
     // Exemplar width: mean outline-to-outline rib length.
-    let per = mesh.per_rib;
     let we = (0..spine.len())
         .filter_map(|i| {
             Some(
@@ -213,6 +216,32 @@ mod tests {
         let d_arap = mean_distortion(&mesh, &arap.solve(&pins).unwrap());
         let d_art = mean_distortion(&mesh, &pos);
         assert!(d_arap < 0.1 && d_art < 0.1, "{d_arap} {d_art}");
+    }
+
+    #[test]
+    fn arap_folds_less_than_the_art_brush_on_tight_bends() {
+        // Half-width 4 bent at radius 4: the normal-offset map collapses
+        // the inner side; ARAP lets the inner outline slide and folds less.
+        let mesh = straight_mesh(40, 1.0, 4.0);
+        let radius = 4.0;
+        let q: Vec<Point> = (0..40)
+            .map(|i| {
+                let a = i as f64 / radius;
+                Point::new(radius * a.sin(), radius * (1.0 - a.cos()))
+            })
+            .collect();
+        let art = art_brush_positions(&mesh, &q, 8.0).unwrap();
+        let arap = Arap::new(&mesh, &mesh.spine).unwrap().solve(&q).unwrap();
+        let flips = |pos: &[Point]| {
+            let sign = |p: [Point; 3]| (p[1] - p[0]).cross(p[2] - p[0]).signum();
+            mesh.triangles
+                .iter()
+                .filter(|t| sign(t.map(|v| mesh.rest[v])) != sign(t.map(|v| pos[v])))
+                .count()
+        };
+        let (fa, fr) = (flips(&art), flips(&arap));
+        assert!(fr * 2 < fa, "ARAP folds {fr}, art brush {fa}");
+        assert!(mean_distortion(&mesh, &arap) < mean_distortion(&mesh, &art));
     }
 
     #[test]

@@ -82,6 +82,48 @@ fn link(params: &SeamParams, lp: f64, rp: f64, lq: f64, rq: f64) -> i64 {
     (w * SCALE).round().max(0.0) as i64
 }
 
+/// The seam problem of two segments drawn on one canvas: `a` and `b` say
+/// which canvas pixels each covers. Returns the crop origin `(x0, y0)` and
+/// the [`Cover`] grid over the bounding box of the pixels both cover,
+/// widened by `margin` pixels (so the single-covered pixels bordering the
+/// overlap tie the cut to its segments), or `None` when they do not
+/// overlap or the masks differ in size.
+pub fn overlap_cover(
+    a: &Grid<bool>,
+    b: &Grid<bool>,
+    margin: usize,
+) -> Option<(usize, usize, Grid<Cover>)> {
+    let (w, h) = (a.width(), a.height());
+    if b.width() != w || b.height() != h {
+        return None;
+    }
+    let (mut x0, mut y0, mut x1, mut y1) = (usize::MAX, usize::MAX, 0, 0);
+    for y in 0..h {
+        for x in 0..w {
+            if a.get(x, y) && b.get(x, y) {
+                (x0, y0, x1, y1) = (x0.min(x), y0.min(y), x1.max(x), y1.max(y));
+            }
+        }
+    }
+    if x0 > x1 {
+        return None;
+    }
+    let (x0, y0) = (x0.saturating_sub(margin), y0.saturating_sub(margin));
+    let (x1, y1) = (
+        x1.saturating_add(margin).min(w - 1),
+        y1.saturating_add(margin).min(h - 1),
+    );
+    let cover = Grid::from_fn(x1 - x0 + 1, y1 - y0 + 1, |x, y| {
+        match (a.get(x + x0, y + y0), b.get(x + x0, y + y0)) {
+            (true, true) => Cover::Both,
+            (true, false) => Cover::A,
+            (false, true) => Cover::B,
+            (false, false) => Cover::None,
+        }
+    });
+    Some((x0, y0, cover))
+}
+
 /// Finds the least-cost seam between segments A and B on an overlap grid:
 /// `a` and `b` are their intensities per pixel (0 ink … 1 paper; use 1
 /// where a segment does not cover), `cover` which segments cover each pixel.
@@ -293,6 +335,21 @@ mod tests {
         // A straight vertical seam of h links across agreeing paper costs
         // h × (0 + C) exactly.
         assert!((s.cost - h as f64 * 0.02).abs() < 1e-9, "{}", s.cost);
+    }
+
+    #[test]
+    fn overlap_cover_crops_to_the_overlap() {
+        let a = Grid::from_fn(20, 10, |x, _| x < 12);
+        let b = Grid::from_fn(20, 10, |x, y| x >= 8 && y >= 3);
+        let (x0, y0, c) = overlap_cover(&a, &b, 2).unwrap();
+        assert_eq!((x0, y0, c.width(), c.height()), (6, 1, 8, 9));
+        assert_eq!(c.get(0, 0), Cover::A);
+        assert_eq!(c.get(3, 5), Cover::Both);
+        assert_eq!(c.get(7, 8), Cover::B);
+        assert_eq!(c.get(7, 0), Cover::None);
+        let none = Grid::new(20, 10, false);
+        assert!(overlap_cover(&a, &none, 2).is_none());
+        assert!(overlap_cover(&a, &Grid::new(3, 3, true), 2).is_none());
     }
 
     #[test]

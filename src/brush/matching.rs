@@ -15,10 +15,11 @@
 //! - a **jump penalty** at every segment boundary, plus the squared
 //!   difference of the two boundary samples' appearance descriptors and
 //!   thicknesses (rib lengths), so jumps happen only between look-alikes;
-//! - a minimum segment length (in samples).
+//! - a minimum and an optional maximum segment length (in samples).
 //!
 //! The minimum is found by dynamic programming over (query sample,
-//! candidate, run length capped at the minimum segment length). Candidates
+//! candidate, run length — exact up to the maximum segment length, or
+//! capped at the minimum when there is no maximum). Candidates
 //! per query sample are the `candidates` best exemplar samples by data term
 //! plus the continuations of the `beam` best states of the previous sample,
 //! so the cost is O(query × candidates²); with unlimited candidates the DP is
@@ -29,6 +30,7 @@
 use crate::brush::query::QuerySpine;
 use crate::error::{Error, Result};
 use crate::pattern::rng;
+use kurbo::Point;
 use std::collections::HashMap;
 use std::ops::Range;
 
@@ -59,6 +61,47 @@ pub struct SpineFeatures {
 }
 
 impl SpineFeatures {
+    /// The features of an exemplar given by its ribs (spine, left and right
+    /// outline points per sample, equally spaced along the spine, in the
+    /// common length unit): turning angles and end distances from the
+    /// spine, width from the rib length `|left − right|`, and the given
+    /// appearance descriptors (one per rib, or none).
+    pub fn from_ribs(
+        spine: &[Point],
+        left: &[Point],
+        right: &[Point],
+        appearance: Vec<Vec<f64>>,
+    ) -> Result<Self> {
+        let n = spine.len();
+        if n < 2 || left.len() != n || right.len() != n {
+            return Err(Error::degenerate(
+                "exemplar features",
+                "needs at least two ribs with spine, left and right points",
+            ));
+        }
+        if !appearance.is_empty() && appearance.len() != n {
+            return Err(Error::degenerate(
+                "exemplar features",
+                format!("{} appearance descriptors for {n} ribs", appearance.len()),
+            ));
+        }
+        let length = crate::brush::query::polyline_length(spine);
+        let samples = crate::brush::query::features(spine, 0.0, length)
+            .iter()
+            .zip(left.iter().zip(right))
+            .map(|(q, (l, r))| SampleFeature {
+                turning: q.turning,
+                width: l.distance(*r),
+                dist_start: q.dist_start,
+                dist_end: q.dist_end,
+            })
+            .collect();
+        Ok(SpineFeatures {
+            samples,
+            appearance,
+        })
+    }
+
     /// The features of a query spine (no appearance descriptors).
     pub fn from_query(q: &QuerySpine) -> Self {
         SpineFeatures {
@@ -113,6 +156,9 @@ pub struct MatchOptions {
     /// Shortest segment, in samples (default 5; shorter queries are one
     /// segment).
     pub min_segment: usize,
+    /// Longest segment, in samples (default `None`: as long as the
+    /// exemplar allows; costs one DP slot per sample of length).
+    pub max_segment: Option<usize>,
     /// Samples by which each segment is extended into its neighbours
     /// (default 4).
     pub overlap: usize,
@@ -138,6 +184,7 @@ impl Default for MatchOptions {
             w_appearance: 10.0,
             w_thickness: 10.0,
             min_segment: 5,
+            max_segment: None,
             overlap: 4,
             seed: 0,
             tie_tolerance: 1e-9,
@@ -317,6 +364,12 @@ impl<'a> Problem<'a> {
         self.opts.min_segment.clamp(1, self.query_len())
     }
 
+    /// The effective longest segment, if limited: the option, at least the
+    /// effective shortest.
+    pub fn max_segment(&self) -> Option<usize> {
+        self.opts.max_segment.map(|m| m.max(self.min_segment()))
+    }
+
     /// The cost of a segmentation given as (exemplar, first exemplar sample,
     /// query range) triples tiling the query, as the DP counts it.
     pub fn cost_of(&self, segs: &[(usize, usize, Range<usize>)]) -> f64 {
@@ -343,7 +396,8 @@ enum Back {
 }
 
 /// One DP layer: candidates and, per candidate, cost and back pointer per
-/// run length 1..=L (index r − 1).
+/// run length 1..=slots (index r − 1; the last slot holds all longer runs
+/// when there is no maximum).
 struct Layer {
     cands: Vec<(usize, usize)>,
     cost: Vec<f64>,
@@ -360,20 +414,50 @@ pub fn match_query(
     let p = Problem::new(query, exemplars, opts)?;
     let n = p.query_len();
     let lmin = p.min_segment();
+    // Run-length slots per candidate: exact up to the maximum segment
+    // length when there is one, else capped at the minimum (all longer runs
+    // behave alike).
+    let (slots, capped) = match opts.max_segment {
+        Some(m) => (m.max(lmin), false),
+        None => (lmin, true),
+    };
     let lens = p.exemplar_lens();
     let tol = |c: f64| opts.tie_tolerance * (1.0 + c.abs());
+    let near_better = |v: f64, key: u64, cur: f64, cur_key: u64| {
+        !cur.is_finite() || v < cur - tol(cur) || (v <= cur + tol(cur) && key < cur_key)
+    };
     let mut layers: Vec<Layer> = Vec::with_capacity(n);
     for q in 0..n {
-        let cands = candidates(&p, q, layers.last(), lmin, &lens);
+        let cands = candidates(&p, q, layers.last(), slots, &lens);
         let m = cands.len();
-        let mut cost = vec![f64::INFINITY; m * lmin];
-        let mut back = vec![Back::Start; m * lmin];
+        let mut cost = vec![f64::INFINITY; m * slots];
+        let mut back = vec![Back::Start; m * slots];
+        // Per previous candidate: its best complete run (length ≥ minimum).
+        let complete: Vec<Option<(f64, usize)>> = layers.last().map_or(Vec::new(), |prev| {
+            (0..prev.cands.len())
+                .map(|pi| {
+                    let mut best: Option<(f64, usize, u64)> = None;
+                    for r in lmin - 1..slots {
+                        let v = prev.cost[pi * slots + r];
+                        let key = rng::hash(&[opts.seed, q as u64, pi as u64, r as u64, 0xC0]);
+                        let take = v.is_finite()
+                            && best.map_or(true, |(bv, _, bk)| near_better(v, key, bv, bk));
+                        if take {
+                            best = Some((v, r, key));
+                        }
+                    }
+                    best.map(|(v, r, _)| (v, r))
+                })
+                .collect()
+        });
         // Offers a value for slot (c, r); near-ties go to the lower hash.
-        let mut offer = |slot: usize, v: f64, b: Back, key: u64| {
+        // The hashes are computed only for near-ties.
+        let mut offer = |slot: usize, v: f64, b: Back| {
             let cur = cost[slot];
             let better = !cur.is_finite()
                 || v < cur - tol(cur)
-                || (v <= cur + tol(cur) && key < back_key(opts.seed, q, slot, back[slot]));
+                || (v <= cur + tol(cur)
+                    && back_key(opts.seed, q, slot, b) < back_key(opts.seed, q, slot, back[slot]));
             if v.is_finite() && better {
                 cost[slot] = v;
                 back[slot] = b;
@@ -385,32 +469,29 @@ pub fn match_query(
                 continue;
             }
             let Some(prev) = layers.last() else {
-                offer(
-                    ci * lmin,
-                    u,
-                    Back::Start,
-                    back_key(opts.seed, q, ci * lmin, Back::Start),
-                );
+                offer(ci * slots, u, Back::Start);
                 continue;
             };
-            // A new segment after a complete one (run length ≥ L).
+            // A new segment after a complete one.
             for (pi, &pc) in prev.cands.iter().enumerate() {
-                let v = prev.cost[pi * lmin + lmin - 1];
-                if v.is_finite() {
-                    let b = Back::Jump(pi, lmin - 1);
-                    let w = v + p.jump(pc, (e, s)) + u;
-                    offer(ci * lmin, w, b, back_key(opts.seed, q, ci * lmin, b));
+                if let Some(&Some((v, r))) = complete.get(pi) {
+                    offer(ci * slots, v + p.jump(pc, (e, s)) + u, Back::Jump(pi, r));
                 }
             }
             // Continuing the segment that matched (e, s − 1).
             if s > 0 {
                 if let Some(pi) = prev.cands.iter().position(|&c| c == (e, s - 1)) {
-                    for r in 0..lmin {
-                        let v = prev.cost[pi * lmin + r];
+                    for r in 0..slots {
+                        let v = prev.cost[pi * slots + r];
+                        let next = if r + 1 < slots {
+                            r + 1
+                        } else if capped {
+                            slots - 1
+                        } else {
+                            continue; // the segment is as long as allowed
+                        };
                         if v.is_finite() {
-                            let slot = ci * lmin + (r + 1).min(lmin - 1);
-                            let b = Back::Continue(pi, r);
-                            offer(slot, v + u, b, back_key(opts.seed, q, slot, b));
+                            offer(ci * slots + next, v + u, Back::Continue(pi, r));
                         }
                     }
                 }
@@ -424,24 +505,19 @@ pub fn match_query(
         .ok_or_else(|| Error::degenerate("piecewise matching", "empty query"))?;
     let mut best: Option<(usize, f64, u64)> = None;
     for ci in 0..last.cands.len() {
-        let slot = ci * lmin + lmin - 1;
-        let v = last.cost[slot];
-        if !v.is_finite() {
-            continue;
-        }
-        let key = rng::hash(&[opts.seed, n as u64, ci as u64, 0xE2D]);
-        let take = match best {
-            None => true,
-            Some((_, bv, bk)) => v < bv - tol(bv) || (v <= bv + tol(bv) && key < bk),
-        };
-        if take {
-            best = Some((slot, v, key));
+        for r in lmin - 1..slots {
+            let slot = ci * slots + r;
+            let v = last.cost[slot];
+            let key = rng::hash(&[opts.seed, n as u64, slot as u64, 0xE2D]);
+            if v.is_finite() && best.map_or(true, |(_, bv, bk)| near_better(v, key, bv, bk)) {
+                best = Some((slot, v, key));
+            }
         }
     }
     let Some((mut slot, total, _)) = best else {
         return Err(Error::degenerate(
             "piecewise matching",
-            format!("no exemplar segment of at least {lmin} samples fits the query"),
+            format!("no exemplar segments of {lmin} to {slots} samples fit the query"),
         ));
     };
     // Backtrack: assignment per query sample and segment starts.
@@ -449,14 +525,14 @@ pub fn match_query(
     let mut starts = vec![false; n];
     for q in (0..n).rev() {
         let layer = &layers[q];
-        assign[q] = layer.cands[slot / lmin];
+        assign[q] = layer.cands[slot / slots];
         match layer.back[slot] {
             Back::Start => starts[q] = true,
             Back::Jump(pi, r) => {
                 starts[q] = true;
-                slot = pi * lmin + r;
+                slot = pi * slots + r;
             }
-            Back::Continue(pi, r) => slot = pi * lmin + r,
+            Back::Continue(pi, r) => slot = pi * slots + r,
         }
     }
     Ok(Matching {
@@ -481,7 +557,7 @@ fn candidates(
     p: &Problem,
     q: usize,
     prev: Option<&Layer>,
-    lmin: usize,
+    slots: usize,
     lens: &[usize],
 ) -> Vec<(usize, usize)> {
     let o = p.opts;
@@ -513,7 +589,7 @@ fn candidates(
     if let Some(prev) = prev {
         let mut best: Vec<(f64, usize)> = (0..prev.cands.len())
             .map(|ci| {
-                let m = prev.cost[ci * lmin..(ci + 1) * lmin]
+                let m = prev.cost[ci * slots..(ci + 1) * slots]
                     .iter()
                     .fold(f64::INFINITY, |a, &b| a.min(b));
                 (m, ci)

@@ -1,6 +1,7 @@
 //! Tests of the piecewise matching: the DP against exhaustive enumeration.
 
 use super::*;
+use kurbo::Point;
 use proptest::prelude::*;
 
 fn straight(n: usize, width: f64, turning: f64) -> SpineFeatures {
@@ -29,7 +30,8 @@ fn exhaustive(p: &Problem, q0: usize, last: Option<(usize, usize)>) -> f64 {
     }
     let lens = p.exemplar_lens();
     let mut best = f64::INFINITY;
-    for len in p.min_segment()..=n - q0 {
+    let longest = p.max_segment().unwrap_or(n).min(n - q0);
+    for len in p.min_segment()..=longest {
         for (e, &le) in lens.iter().enumerate() {
             for s0 in 0..le {
                 if s0 + len > le {
@@ -92,11 +94,13 @@ proptest! {
         query in features(6),
         exemplars in proptest::collection::vec(features(5), 1..=3),
         min_segment in 1usize..=3,
+        max_segment in proptest::option::of(1usize..=4),
         seed in 0u64..4,
     ) {
         let opts = MatchOptions {
             candidates: usize::MAX,
             min_segment,
+            max_segment,
             end_zone: 0.3,
             end_horizon: 1.0,
             seed,
@@ -114,6 +118,7 @@ proptest! {
                 for s in &m.segments {
                     prop_assert_eq!(s.core.start, q);
                     prop_assert!(s.core.len() >= p.min_segment());
+                    prop_assert!(s.core.len() <= p.max_segment().unwrap_or(usize::MAX));
                     prop_assert_eq!(s.query.len(), s.exemplar_samples.len());
                     prop_assert!(s.exemplar_samples.end <= exemplars[s.exemplar].samples.len());
                     q = s.core.end;
@@ -234,4 +239,42 @@ fn bad_inputs_are_errors() {
         ..MatchOptions::default()
     };
     assert!(match_query(&q, &[straight(3, 1.0, 0.0)], &opts).is_err());
+}
+
+#[test]
+fn rib_features_measure_turning_width_and_ends() {
+    // A quarter circle of radius 20, 11 ribs, half-widths 3 (left) and 2.
+    let r = 20.0;
+    let pt = |a: f64, d: f64| Point::new((r - d) * a.sin(), r - (r - d) * a.cos());
+    let angles: Vec<f64> = (0..11)
+        .map(|i| i as f64 * std::f64::consts::FRAC_PI_2 / 10.0)
+        .collect();
+    let spine: Vec<Point> = angles.iter().map(|&a| pt(a, 0.0)).collect();
+    let left: Vec<Point> = angles.iter().map(|&a| pt(a, 3.0)).collect();
+    let right: Vec<Point> = angles.iter().map(|&a| pt(a, -2.0)).collect();
+    let f = SpineFeatures::from_ribs(&spine, &left, &right, vec![]).unwrap();
+    let step = std::f64::consts::FRAC_PI_2 / 10.0;
+    for (i, s) in f.samples.iter().enumerate() {
+        assert!((s.width - 5.0).abs() < 1e-9);
+        if i > 0 && i < 10 {
+            assert!((s.turning - step).abs() < 1e-9, "{}", s.turning);
+        }
+    }
+    assert_eq!(f.samples[0].dist_start, 0.0);
+    assert!((f.samples[10].dist_start - f.samples[0].dist_end).abs() < 1e-9);
+    assert!(SpineFeatures::from_ribs(&spine, &left[1..], &right, vec![]).is_err());
+    assert!(SpineFeatures::from_ribs(&spine, &left, &right, vec![vec![1.0]]).is_err());
+}
+
+#[test]
+fn max_segment_splits_long_runs() {
+    let q = straight(40, 1.0, 0.0);
+    let ex = [straight(60, 1.0, 0.0)];
+    let opts = MatchOptions {
+        max_segment: Some(12),
+        ..MatchOptions::default()
+    };
+    let m = match_query(&q, &ex, &opts).unwrap();
+    assert!(m.segments.len() >= 4, "{:?}", m.segments);
+    assert!(m.segments.iter().all(|s| s.core.len() <= 12));
 }

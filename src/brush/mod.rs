@@ -11,7 +11,8 @@
 //!   onto the query spine (Igarashi et al. 2005), and the rasterized map back
 //!   to exemplar coordinates;
 //! - [`graphcut`]: §5.3 seams between overlapping warped segments, an exact
-//!   s–t minimum cut of Eq. 1–2 (oracle: brute force on tiny grids);
+//!   s–t minimum cut of Eq. 1–2 (oracle: brute force on tiny grids), on
+//!   the Boykov–Kolmogorov max-flow of [`maxflow`] (oracle: Dinic);
 //! - [`synth`]: §5.4 hierarchical synthesis of exemplar coordinates
 //!   (oriented-neighbourhood correction, coordinate upsampling);
 //! - [`pipeline`]: the stages chained for one query, on its own canvas;

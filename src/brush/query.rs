@@ -191,20 +191,16 @@ fn path_is_finite(path: &BezPath) -> bool {
     })
 }
 
+/// Whether the polyline's bounding box meets `view` (edges included).
 fn touches(poly: &[Point], view: Rect) -> bool {
     let Some(first) = poly.first() else {
         return true; // empty subpaths are reported as degenerate instead
     };
-    let bbox = poly
+    let r = poly
         .iter()
         .fold(Rect::from_points(*first, *first), |r, p| r.union_pt(*p));
-    bbox.intersect(view).area() > 0.0
-        || view.contains(*first)
-        || bbox.area() == 0.0 && {
-            // A horizontal or vertical segment has a zero-area box.
-            let r = bbox;
-            r.x1 >= view.x0 && r.x0 <= view.x1 && r.y1 >= view.y0 && r.y0 <= view.y1
-        }
+    // Closed intervals, so lines along an edge of the view still count.
+    r.x1 >= view.x0 && r.x0 <= view.x1 && r.y1 >= view.y0 && r.y0 <= view.y1
 }
 
 /// Flattens every subpath of `path` into a polyline (closed subpaths end on
@@ -463,6 +459,21 @@ mod tests {
         assert_eq!(set.notes.len(), 1, "{:?}", set.notes);
         // `dot` has no geometry: sketch.rs already drops it with a note.
         assert!(s.notes.iter().any(|n| n.contains("dot")));
+    }
+
+    #[test]
+    fn degenerate_subpaths_are_skipped_and_the_rest_kept() {
+        let s = sketch(
+            r##"<path id="multi" d="M10 20 L60 20 M90 90 L90 90 M100 100 Z M120 120 L150 150" stroke="#000" stroke-width="4" fill="none"/>"##,
+        );
+        let set = spines(&s, &QueryOptions::default()).unwrap();
+        let ids: Vec<usize> = set.spines.iter().map(|s| s.subpath).collect();
+        assert_eq!(set.spines.len(), 2, "{ids:?} {:?}", set.warnings);
+        assert!(!set.warnings.is_empty());
+        assert!(set
+            .warnings
+            .iter()
+            .all(|w| w.starts_with("s.svg: query multi subpath")));
     }
 
     #[test]
