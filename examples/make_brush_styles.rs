@@ -710,7 +710,7 @@ struct Style {
 fn write_style(root: &Path, style: Style) -> std::io::Result<()> {
     let dir = root.join(style.name);
     std::fs::create_dir_all(&dir)?;
-    let mut toml = String::from("kind = \"brush\"\nresolution = 256\nsdf = true\n");
+    let mut toml = String::from("kind = \"brush\"\nresolution = 512\nsdf = true\n");
     let cols = 4;
     let cell = 320u32;
     let rows = style.exemplars.len().div_ceil(cols) as u32;
@@ -855,7 +855,7 @@ mod vine {
             Spec {
                 seed: 2,
                 spine: &[(0.0, 0.0), (70.0, 0.0), (140.0, -6.0), (210.0, -4.0)],
-                width: 5.6,
+                width: 6.3,
                 start: Start::Bud,
                 end: End::Curl,
                 spacing: 52.0,
@@ -1106,7 +1106,8 @@ mod vine {
         let out = stem_angle - side * rng.range(0.85, 1.0);
         let stalk_len = 13.0 * size;
         let stalk = Centerline::turtle(p, out, stalk_len, |_| side * 0.02);
-        let sw = 0.45 * stem_w.max(3.0);
+        // At least 2 px wide at the coarsest analysis level (8 units) at its tip.
+        let sw = (0.45 * stem_w).max(6.0);
         ex.add(STEM, stroke(&stalk, |u, _| lerp(sw * 1.2, sw * 0.7, u)));
         let len = 78.0 * size;
         let shape = LeafShape {
@@ -1133,7 +1134,12 @@ mod vine {
         let len = rng.range(150.0, 180.0) * size;
         // Curl back toward the stem's start, away from the leaves ahead.
         let line = spiral(p, out, len, side * 0.008, -side * 0.17, 1.9);
-        ex.add(STEM, stroke(&line, |u, _| 3.0 * (1.0 - u).powf(0.7)));
+        // Full width (≥ 2 px at the coarsest analysis level) until the last
+        // fifth, which tapers to the spiral's point.
+        ex.add(
+            STEM,
+            stroke(&line, |u, _| 4.4 * ((1.0 - u) / 0.2).min(1.0).powf(0.6)),
+        );
     }
 
     /// Three berries on a forked stalk.
@@ -1147,13 +1153,13 @@ mod vine {
     ) {
         let out = stem_angle - side * rng.range(0.7, 0.9);
         let stalk = Centerline::turtle(p, out, 24.0 * size, |_| 0.0);
-        ex.add(STEM, stroke(&stalk, |u, _| lerp(2.6, 2.0, u)));
+        ex.add(STEM, stroke(&stalk, |u, _| lerp(4.4, 4.2, u)));
         let fork = stalk.end();
         let base = stalk.end_angle();
         for (da, l, r) in [(-0.6, 18.0, 7.5), (0.05, 25.0, 8.5), (0.7, 17.0, 7.0)] {
             let a = base + da * side;
             let twig = Centerline::turtle(fork, a, l * size, |_| side * 0.01);
-            ex.add(STEM, stroke(&twig, |u, _| lerp(2.0, 1.5, u)));
+            ex.add(STEM, stroke(&twig, |u, _| lerp(4.2, 4.1, u)));
             let c = twig.end() + dir(twig.end_angle()) * (r * size * 0.8);
             ex.add(STEM, circle(c, r * size.sqrt()));
         }
@@ -1198,7 +1204,7 @@ mod scroll {
     /// moving this way are hairlines, strokes across it are full width.
     const NIB: f64 = -0.62;
     /// Hairline half width, px.
-    const THIN: f64 = 1.3;
+    const THIN: f64 = 3.0;
 
     /// Half width of a broad-nib stroke moving along `t`.
     fn nib(t: Vec2, thick: f64) -> f64 {
@@ -1550,8 +1556,9 @@ mod scroll {
                 INK,
                 stroke(&line, |u, t| {
                     let swell = lerp(0.55, 1.0, smoothstep(0.0, 0.15, u));
-                    let taper = ((1.0 - u) / 0.8).min(1.0).powf(1.15);
-                    nib(t, fw) * swell * taper
+                    let taper = ((1.0 - u) / 0.55).min(1.0).powf(1.15);
+                    // Never a hairline before the tip (2 px at the coarsest level).
+                    (nib(t, fw) * swell).max(4.0) * taper
                 }),
             );
         }
@@ -1619,7 +1626,7 @@ mod doodle {
                 height: 56.0,
                 reach: 2.2,
                 garland: false,
-                pen: 3.6,
+                pen: 4.5,
                 start: Ball,
                 end: Ball,
             },
@@ -1630,7 +1637,7 @@ mod doodle {
                 height: 60.0,
                 reach: 2.2,
                 garland: true,
-                pen: 3.4,
+                pen: 4.2,
                 start: Ball,
                 end: Hook(1.0),
             },
@@ -1641,7 +1648,7 @@ mod doodle {
                 height: 64.0,
                 reach: 2.1,
                 garland: true,
-                pen: 3.8,
+                pen: 4.8,
                 start: Hook(-1.0),
                 end: Ball,
             },
@@ -1652,7 +1659,7 @@ mod doodle {
                 height: 42.0,
                 reach: 2.8,
                 garland: false,
-                pen: 3.4,
+                pen: 4.2,
                 start: Ball,
                 end: Ball,
             },
@@ -1663,7 +1670,7 @@ mod doodle {
                 height: 52.0,
                 reach: 2.0,
                 garland: false,
-                pen: 3.8,
+                pen: 4.8,
                 start: Hook(1.0),
                 end: Hook(-1.0),
             },
@@ -1674,7 +1681,7 @@ mod doodle {
                 height: 80.0,
                 reach: 2.2,
                 garland: true,
-                pen: 4.0,
+                pen: 5.0,
                 start: Ball,
                 end: Hook(1.0),
             },
@@ -1685,7 +1692,7 @@ mod doodle {
                 height: 36.0,
                 reach: 3.2,
                 garland: false,
-                pen: 3.3,
+                pen: 4.1,
                 start: Ball,
                 end: Ball,
             },
@@ -1696,7 +1703,7 @@ mod doodle {
                 height: 60.0,
                 reach: 1.7,
                 garland: false,
-                pen: 3.7,
+                pen: 4.6,
                 start: Hook(-1.0),
                 end: Ball,
             },
@@ -1707,7 +1714,7 @@ mod doodle {
                 height: 62.0,
                 reach: 2.3,
                 garland: true,
-                pen: 3.6,
+                pen: 4.5,
                 start: Ball,
                 end: Ball,
             },
@@ -1718,7 +1725,7 @@ mod doodle {
                 height: 66.0,
                 reach: 2.4,
                 garland: false,
-                pen: 3.8,
+                pen: 4.8,
                 start: Ball,
                 end: Hook(1.0),
             },
@@ -1799,7 +1806,7 @@ mod doodle {
         let width = |u: f64, _t: Vec2| -> f64 {
             let s = u * total;
             // A little pen pressure variation; hooks flick off to a point.
-            let w = pen * (1.0 + 0.1 * (s / 37.0 + phase).sin());
+            let w = pen * (1.05 + 0.05 * (s / 37.0 + phase).sin());
             let a = if pre > 0.0 {
                 (s / pre).min(1.0).powf(0.6)
             } else {

@@ -41,6 +41,42 @@ enum Command {
     Brush(BrushArgs),
     /// Compare two SVGs by rendering; exit 1 when they differ beyond --tolerance.
     Diff(DiffArgs),
+    /// Style libraries: analyse, report and draw diagnostics.
+    Style(StyleArgs),
+}
+
+#[derive(Args)]
+struct StyleArgs {
+    #[command(subcommand)]
+    command: StyleCommand,
+}
+
+#[derive(Subcommand)]
+enum StyleCommand {
+    /// Analyse a brush library: a report per exemplar, warnings, and a diagnostics sheet.
+    Check(StyleCheckArgs),
+}
+
+#[derive(Args)]
+struct StyleCheckArgs {
+    /// Brush style: a folder holding style.toml, or a name in --styles.
+    #[arg(value_name = "STYLE")]
+    style: String,
+    /// Write the diagnostics sheet (spine, ribs, orientation field) to this PNG.
+    #[arg(long, value_name = "OUT.png")]
+    sheet: Option<PathBuf>,
+    /// Folder of named styles (default: the styles shipped with flourish).
+    #[arg(long, value_name = "DIR")]
+    styles: Option<PathBuf>,
+    /// Cache folder for the analysis (default: $FLOURISH_CACHE_DIR, else the platform cache).
+    #[arg(long, value_name = "DIR")]
+    cache: Option<PathBuf>,
+    /// Analyse afresh: neither read nor write the cache.
+    #[arg(long)]
+    no_cache: bool,
+    /// Exit 1 when there are warnings.
+    #[arg(long)]
+    strict: bool,
 }
 
 #[derive(Args)]
@@ -207,6 +243,9 @@ fn run(cli: Cli) -> Result<(), Failure> {
         Command::Pattern(args) => run_pattern(args, cli.quiet, cli.verbose),
         Command::Brush(args) => run_brush(args, cli.quiet, cli.verbose),
         Command::Diff(args) => run_diff(args, cli.quiet),
+        Command::Style(StyleArgs {
+            command: StyleCommand::Check(args),
+        }) => run_style_check(args, cli.quiet),
     }
 }
 
@@ -514,6 +553,36 @@ fn run_diff(args: DiffArgs, quiet: bool) -> Result<(), Failure> {
         );
     }
     if report.fraction() > args.tolerance {
+        return Err(Failure::Differ);
+    }
+    Ok(())
+}
+
+fn run_style_check(args: StyleCheckArgs, quiet: bool) -> Result<(), Failure> {
+    use flourish::style::{self, brush, check};
+    let styles_dir = args.styles.unwrap_or_else(style::default_styles_dir);
+    let dir = style::resolve(&args.style, &styles_dir)?;
+    let opts = brush::AnalysisOptions {
+        cache_dir: args.cache,
+        use_cache: !args.no_cache,
+        ..brush::AnalysisOptions::default()
+    };
+    let analysed = brush::BrushStyle::load(&dir, &opts)?;
+    let report = check::check(&analysed, &check::CheckOptions::default());
+    if let Some(sheet) = &args.sheet {
+        let png = check::sheet_png(&analysed, sheet)?;
+        io::write_atomic(sheet, &png)?;
+    }
+    if !quiet {
+        print!("{}", report.to_text());
+    } else {
+        for e in &report.exemplars {
+            for w in &e.warnings {
+                eprintln!("flourish: {}: {w}", dir.join(&e.file).display());
+            }
+        }
+    }
+    if args.strict && report.warning_count() > 0 {
         return Err(Failure::Differ);
     }
     Ok(())

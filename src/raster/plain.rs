@@ -51,6 +51,26 @@ impl Plain for u16 {
     }
 }
 
+impl Plain for i16 {
+    const BYTES: usize = 2;
+    fn put(self, out: &mut Vec<u8>) {
+        out.extend_from_slice(&self.to_le_bytes());
+    }
+    fn get(b: &[u8]) -> Self {
+        i16::from_le_bytes([b[0], b[1]])
+    }
+}
+
+impl Plain for u8 {
+    const BYTES: usize = 1;
+    fn put(self, out: &mut Vec<u8>) {
+        out.push(self);
+    }
+    fn get(b: &[u8]) -> Self {
+        b[0]
+    }
+}
+
 impl Plain for bool {
     const BYTES: usize = 1;
     fn put(self, out: &mut Vec<u8>) {
@@ -157,6 +177,93 @@ impl<'de, T: Plain> Deserialize<'de> for Grid<T> {
             }
         }
         d.deserialize_tuple(3, V(std::marker::PhantomData))
+    }
+}
+
+/// Steps per pixel of a quantized signed distance ([`sdf16`]).
+pub const SDF_STEPS: f32 = 128.0;
+/// Largest magnitude of a quantized signed distance, px.
+pub const SDF_LIMIT: f32 = 255.0;
+
+/// Rounds signed distances (px) to the precision [`sdf16`] stores them
+/// with: multiples of 1/[`SDF_STEPS`] px, clamped to ±[`SDF_LIMIT`] px.
+pub fn quantize_sdf(g: &mut Grid<f32>) {
+    for v in g.data_mut() {
+        *v = (v.clamp(-SDF_LIMIT, SDF_LIMIT) * SDF_STEPS).round() / SDF_STEPS;
+    }
+}
+
+/// `#[serde(with = "crate::raster::plain::sdf16")]` for a `Grid<f32>` of
+/// signed distances already rounded by [`quantize_sdf`]: stored as 16-bit
+/// integers (half the bytes), decoded exactly.
+pub mod sdf16 {
+    use super::*;
+
+    /// Serializes `g` as a grid of `i16` steps.
+    pub fn serialize<S: Serializer>(g: &Grid<f32>, s: S) -> Result<S::Ok, S::Error> {
+        g.map(|v| (v.clamp(-SDF_LIMIT, SDF_LIMIT) * SDF_STEPS).round() as i16)
+            .serialize(s)
+    }
+
+    /// Deserializes a grid written by [`serialize`].
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Grid<f32>, D::Error> {
+        let g = Grid::<i16>::deserialize(d)?;
+        Ok(g.map(|v| v as f32 / SDF_STEPS))
+    }
+}
+
+/// `#[serde(with = "crate::raster::plain::bits")]` for a `Grid<bool>`:
+/// eight samples per byte.
+pub mod bits {
+    use super::*;
+
+    /// Serializes `g` as (width, height, packed bits).
+    pub fn serialize<S: Serializer>(g: &Grid<bool>, s: S) -> Result<S::Ok, S::Error> {
+        let mut packed = vec![0u8; g.data().len().div_ceil(8)];
+        for (i, &b) in g.data().iter().enumerate() {
+            if b {
+                packed[i / 8] |= 1 << (i % 8);
+            }
+        }
+        let mut t = s.serialize_tuple(3)?;
+        t.serialize_element(&(g.width() as u64))?;
+        t.serialize_element(&(g.height() as u64))?;
+        t.serialize_element(&BytesRef(&packed))?;
+        t.end()
+    }
+
+    /// Deserializes a grid written by [`serialize`].
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Grid<bool>, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = Grid<bool>;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a bit grid (width, height, bits)")
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Grid<bool>, A::Error> {
+                let w: u64 = seq
+                    .next_element()?
+                    .ok_or_else(|| de::Error::invalid_length(0, &self))?;
+                let h: u64 = seq
+                    .next_element()?
+                    .ok_or_else(|| de::Error::invalid_length(1, &self))?;
+                let Decoded(packed) = seq
+                    .next_element::<Decoded<u8>>()?
+                    .ok_or_else(|| de::Error::invalid_length(2, &self))?;
+                let n = w
+                    .checked_mul(h)
+                    .filter(|&n| n.div_ceil(8) == packed.len() as u64);
+                let Some(n) = n else {
+                    return Err(de::Error::custom("bit grid size does not match its data"));
+                };
+                let data = (0..n as usize)
+                    .map(|i| packed[i / 8] & (1 << (i % 8)) != 0)
+                    .collect();
+                Grid::from_vec(w as usize, h as usize, data)
+                    .ok_or_else(|| de::Error::custom("bit grid size does not match its data"))
+            }
+        }
+        d.deserialize_tuple(3, V)
     }
 }
 

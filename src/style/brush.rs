@@ -108,7 +108,12 @@ pub struct Exemplar {
     /// How the spine was found.
     pub spine_source: SpineSource,
     /// The smooth spine as a dense polyline from start to end, finest px.
+    /// The ribs run along it extended straight beyond both ends over the
+    /// end ornaments ([`uv::extend_to_ink`]), by `extension` px.
     pub spine: Vec<[f64; 2]>,
+    /// How far the ribs extend the spine beyond its start and its end,
+    /// finest px.
+    pub extension: [f64; 2],
     /// The raw Dijkstra path (finest px) when the spine was traced.
     pub path: Vec<[f64; 2]>,
     /// Rib samples (30–100), finest px.
@@ -195,6 +200,25 @@ impl BrushStyle {
         Ok((style, status))
     }
 
+    /// After decoding from the cache: the all-ink grids and the index
+    /// references, which are not stored twice; `false` when the decoded
+    /// data cannot provide them.
+    pub fn restore(&mut self) -> bool {
+        let inks = self
+            .exemplars
+            .iter_mut()
+            .flat_map(|e| e.levels.iter_mut())
+            .all(|l| l.ink.restore_ink());
+        let exemplars: Vec<&Exemplar> = self.exemplars.iter().collect();
+        let refs: Vec<Vec<NeighbourhoodRef>> = (0..self.indexes.len())
+            .map(|l| region_refs(&exemplars, l))
+            .collect();
+        for (idx, r) in self.indexes.iter_mut().zip(refs) {
+            idx.refs = r;
+        }
+        inks
+    }
+
     /// Structural consistency (sizes agree everywhere, references in
     /// range): what a cache file must pass before it is trusted.
     pub fn validate(&self) -> bool {
@@ -249,6 +273,28 @@ impl BrushStyle {
     }
 }
 
+/// The pixels of every exemplar's stroke region at level `l`, exemplar by
+/// exemplar, row-major: the order of a level's [`NeighbourhoodIndex`].
+pub fn region_refs(exemplars: &[&Exemplar], l: usize) -> Vec<NeighbourhoodRef> {
+    let mut refs = Vec::new();
+    for (i, ex) in exemplars.iter().enumerate() {
+        let Some(lv) = ex.levels.get(l) else { continue };
+        let mask = &lv.orientation.mask;
+        for y in 0..mask.height() {
+            for x in 0..mask.width() {
+                if mask.get(x, y) {
+                    refs.push(NeighbourhoodRef {
+                        exemplar: i as u32,
+                        x: x as u32,
+                        y: y as u32,
+                    });
+                }
+            }
+        }
+    }
+    refs
+}
+
 fn style_name(dir: &Path) -> String {
     std::fs::canonicalize(dir)
         .ok()
@@ -277,29 +323,21 @@ pub fn analyse(
         .enumerate()
         .map(|(i, ex)| analyse_exemplar(dir, &toml_path, i, ex, resolution, &sampler, opts))
         .collect::<Result<Vec<_>>>()?;
+    let exemplars: Vec<&Exemplar> = analysed.iter().map(|(e, _)| e).collect();
     let mut indexes = Vec::with_capacity(LEVELS);
     for l in 0..LEVELS {
-        let mut all: Vec<Neighbourhood> = Vec::new();
-        let mut refs = Vec::new();
-        for (i, (ex, hoods)) in analysed.iter().enumerate() {
-            let Some(lv) = ex.levels.get(l) else { continue };
-            let mask = &lv.orientation.mask;
-            let mut k = 0;
-            for y in 0..mask.height() {
-                for x in 0..mask.width() {
-                    if mask.get(x, y) {
-                        if let Some(h) = hoods.get(l).and_then(|v| v.get(k)) {
-                            all.push(*h);
-                            refs.push(NeighbourhoodRef {
-                                exemplar: i as u32,
-                                x: x as u32,
-                                y: y as u32,
-                            });
-                        }
-                        k += 1;
-                    }
-                }
-            }
+        // Neighbourhoods in the order of `region_refs`: exemplar by
+        // exemplar, masked pixels row-major.
+        let all: Vec<Neighbourhood> = analysed
+            .iter()
+            .flat_map(|(_, hoods)| hoods.get(l).into_iter().flatten().copied())
+            .collect();
+        let refs = region_refs(&exemplars, l);
+        if refs.len() != all.len() {
+            return Err(Error::invalid(
+                dir,
+                "internal: neighbourhoods and stroke region disagree",
+            ));
         }
         let pca = Pca::fit(&all);
         let points: Vec<[f32; PCA_DIMS]> = all.par_iter().map(|v| pca.project(v)).collect();
@@ -395,9 +433,10 @@ fn analyse_exemplar(
         return Err(Error::invalid(&path, "the spine has no length"));
     }
     let coarse = ink.levels[0].px_per_unit / fine_ppu;
-    let n = uv::sample_count(length, coarse);
     let reach = 0.5 * fine.ink.width().max(fine.ink.height()) as f64;
-    let ribs = uv::build_ribs(&spine, n, &fine.ink, 1.0 / coarse, reach);
+    let (extended, extension) = uv::extend_to_ink(&spine, &fine.ink, reach);
+    let n = uv::sample_count(length + extension[0] + extension[1], coarse);
+    let ribs = uv::build_ribs(&extended, n, &fine.ink, 1.0 / coarse, reach);
     let layer_grids: Vec<&crate::raster::Grid<f32>> = fine.layers.iter().map(|l| &l.sdf).collect();
     let features = uv::features(&ribs, &fine.ink, &layer_grids);
     let mut levels = Vec::with_capacity(LEVELS);
@@ -436,6 +475,7 @@ fn analyse_exemplar(
             size: ink.size,
             spine_source,
             spine: spine.iter().map(arr).collect(),
+            extension,
             path: path_px.iter().map(arr).collect(),
             ribs,
             features,

@@ -6,7 +6,9 @@
 //!   a new analysis version, gives a new key and a new file.
 //! * File: `NAME-KEY.bin` in the cache folder: a magic tag, the version,
 //!   the full key, then the analysis in postcard with grids as byte
-//!   strings ([`crate::raster::plain`]) so it loads at memory speed.
+//!   strings ([`crate::raster::plain`]) so it loads at memory speed; each
+//!   exemplar and each level's index is its own postcard blob, so they
+//!   decode in parallel.
 //! * Folder: [`AnalysisOptions::cache_dir`](super::brush::AnalysisOptions)
 //!   (`--cache DIR`), else `$FLOURISH_CACHE_DIR`, else the platform's cache
 //!   folder (`~/.cache/flourish/styles` on Linux).
@@ -16,14 +18,17 @@
 //!   analysed again and the file rewritten atomically. Failing to write the
 //!   cache (read-only folder) is not an error.
 
-use super::brush::BrushStyle;
+use super::brush::{BrushStyle, Exemplar};
 use crate::error::Result;
 use crate::io;
+use crate::synth::neighbourhood::{NeighbourhoodIndex, NeighbourhoodSampler};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
 /// Version of the analysis; bump it whenever the analysis or the cached
 /// types change so old caches are rebuilt.
-pub const ANALYSIS_VERSION: u32 = 1;
+pub const ANALYSIS_VERSION: u32 = 4;
 
 /// Environment variable naming the cache folder (below `--cache`).
 pub const CACHE_ENV: &str = "FLOURISH_CACHE_DIR";
@@ -121,9 +126,15 @@ pub fn read(path: &Path, key: &[u8; 32]) -> Read {
     {
         return Read::Unusable;
     }
-    match postcard::from_bytes::<BrushStyle>(&bytes[head..]) {
-        Ok(style) if style.validate() => Read::Found(Box::new(style)),
-        _ => Read::Unusable,
+    match decode(&bytes[head..]) {
+        Some(mut style) => {
+            if style.restore() && style.validate() {
+                Read::Found(Box::new(style))
+            } else {
+                Read::Unusable
+            }
+        }
+        None => Read::Unusable,
     }
 }
 
@@ -136,8 +147,75 @@ pub fn write(path: &Path, key: &[u8; 32], style: &BrushStyle) -> Result<()> {
     bytes.extend_from_slice(MAGIC);
     bytes.extend_from_slice(&ANALYSIS_VERSION.to_le_bytes());
     bytes.extend_from_slice(key);
-    let body = postcard::to_stdvec(style)
+    let body = encode(style)
         .map_err(|e| crate::Error::invalid(path, format!("cannot encode the analysis: {e}")))?;
     bytes.extend_from_slice(&body);
     io::write_atomic(path, &bytes)
+}
+
+/// The style's small fields.
+#[derive(Serialize, Deserialize)]
+struct Head {
+    name: String,
+    resolution: u32,
+    sdf: bool,
+    sampler: NeighbourhoodSampler,
+}
+
+/// The file body: the head and one blob per exemplar and per index.
+#[derive(Serialize, Deserialize)]
+struct Body<'a> {
+    #[serde(borrow)]
+    head: &'a [u8],
+    #[serde(borrow)]
+    exemplars: Vec<&'a [u8]>,
+    #[serde(borrow)]
+    indexes: Vec<&'a [u8]>,
+}
+
+fn encode(style: &BrushStyle) -> postcard::Result<Vec<u8>> {
+    let head = postcard::to_stdvec(&Head {
+        name: style.name.clone(),
+        resolution: style.resolution,
+        sdf: style.sdf,
+        sampler: style.sampler,
+    })?;
+    let exemplars = style
+        .exemplars
+        .par_iter()
+        .map(postcard::to_stdvec)
+        .collect::<postcard::Result<Vec<_>>>()?;
+    let indexes = style
+        .indexes
+        .par_iter()
+        .map(postcard::to_stdvec)
+        .collect::<postcard::Result<Vec<_>>>()?;
+    postcard::to_stdvec(&Body {
+        head: &head,
+        exemplars: exemplars.iter().map(|v| v.as_slice()).collect(),
+        indexes: indexes.iter().map(|v| v.as_slice()).collect(),
+    })
+}
+
+fn decode(bytes: &[u8]) -> Option<BrushStyle> {
+    let body: Body = postcard::from_bytes(bytes).ok()?;
+    let head: Head = postcard::from_bytes(body.head).ok()?;
+    let exemplars = body
+        .exemplars
+        .par_iter()
+        .map(|b| postcard::from_bytes::<Exemplar>(b).ok())
+        .collect::<Option<Vec<_>>>()?;
+    let indexes = body
+        .indexes
+        .par_iter()
+        .map(|b| postcard::from_bytes::<NeighbourhoodIndex>(b).ok())
+        .collect::<Option<Vec<_>>>()?;
+    Some(BrushStyle {
+        name: head.name,
+        resolution: head.resolution,
+        sdf: head.sdf,
+        sampler: head.sampler,
+        exemplars,
+        indexes,
+    })
 }

@@ -19,6 +19,7 @@
 use crate::error::{Error, Result};
 use crate::io;
 use crate::raster::input::{self, InputOptions};
+use crate::raster::plain::quantize_sdf;
 use crate::raster::{Coverage, Grid, Sdf};
 use crate::svg_out::Color;
 use kurbo::{Affine, BezPath, PathEl, Point};
@@ -35,8 +36,11 @@ pub struct Layer {
     /// The layer's colour.
     pub color: Color,
     /// Signed distance to the layer's outline, in pixels of its level,
-    /// negative inside. Layers are stacked bottom first and each one
+    /// negative inside, rounded to 1/128 px and clamped to ±255 px
+    /// ([`crate::raster::plain::quantize_sdf`], so the cache stores it
+    /// exactly in 16 bits). Layers are stacked bottom first and each one
     /// extends under the layers above it (so their fills leave no seams).
+    #[serde(with = "crate::raster::plain::sdf16")]
     pub sdf: Grid<f32>,
 }
 
@@ -48,8 +52,29 @@ pub struct InkLevel {
     /// The layers, bottom first.
     pub layers: Vec<Layer>,
     /// Signed distance to the outline of all ink (every layer together),
-    /// in pixels of this level, negative inside.
+    /// in pixels of this level, negative inside. Layers stack, so this is
+    /// the bottom layer's SDF; the cache does not store it twice (see
+    /// [`InkLevel::restore_ink`]).
+    #[serde(skip, default = "empty_grid")]
     pub ink: Grid<f32>,
+}
+
+fn empty_grid() -> Grid<f32> {
+    Grid::new(0, 0, 0.0)
+}
+
+impl InkLevel {
+    /// Sets `ink` from the bottom layer (after decoding from the cache);
+    /// `false` when there is no layer.
+    pub fn restore_ink(&mut self) -> bool {
+        match self.layers.first() {
+            Some(l) => {
+                self.ink = l.sdf.clone();
+                true
+            }
+            None => false,
+        }
+    }
 }
 
 /// An exemplar file read as ink.
@@ -99,19 +124,14 @@ fn load_svg(path: &Path, bytes: &[u8], resolution: u32) -> Result<ExemplarInk> {
             invert: false,
             layers: true,
         };
-        let layered = input::svg_ink(path, &tree, &opts, Some(SPINE_ID))?;
-        let ink = if layered.layers.len() == 1 {
-            layered.layers[0].sdf.dist.clone()
-        } else {
-            let all = InputOptions {
-                layers: false,
-                ..opts
-            };
-            let mut one = input::svg_ink(path, &tree, &all, Some(SPINE_ID))?;
-            match one.layers.pop() {
-                Some(layer) => layer.sdf.dist,
-                None => Grid::new(1, 1, 1.0),
-            }
+        let mut layered = input::svg_ink(path, &tree, &opts, Some(SPINE_ID))?;
+        for l in &mut layered.layers {
+            quantize_sdf(&mut l.sdf.dist);
+        }
+        // Layers stack: the bottom one holds every colour, i.e. all ink.
+        let ink = match layered.layers.first() {
+            Some(l) => l.sdf.dist.clone(),
+            None => Grid::new(1, 1, 1.0),
         };
         levels.push(InkLevel {
             px_per_unit: res as f64 / size[0].max(size[1]).max(1e-9),
@@ -155,21 +175,19 @@ fn find_spine(group: &usvg::Group) -> Option<BezPath> {
 
 /// The first subpath of `path` flattened to 0.05 user units.
 fn polyline(path: &BezPath) -> Vec<Point> {
-    let mut pts = Vec::new();
-    let mut started = false;
+    let mut pts: Vec<Point> = Vec::new();
+    // Subpaths seen so far: only the first one is kept.
+    let mut subpaths = 0;
     kurbo::flatten(path, 0.05, |el| match el {
-        PathEl::MoveTo(p) if !started => {
-            started = true;
-            pts.push(p);
-        }
-        PathEl::LineTo(p) if started => {
-            if pts.last() != Some(&p) {
+        PathEl::MoveTo(p) => {
+            subpaths += 1;
+            if subpaths == 1 {
                 pts.push(p);
             }
         }
+        PathEl::LineTo(p) if subpaths == 1 && pts.last() != Some(&p) => pts.push(p),
         _ => {}
     });
-    // Only the first subpath: stop at the second MoveTo.
     pts
 }
 
@@ -189,8 +207,6 @@ fn load_raster(path: &Path, bytes: &[u8], resolution: u32) -> Result<ExemplarInk
         .iter()
         .map(|l| (l.color, l.sdf.dist.map(|d| (0.5 - d).clamp(0.0, 1.0))))
         .collect();
-    // All ink: the bottom layer extends under every layer above it.
-    let all = covs.first().map(|(_, c)| c.clone());
     let mut levels = Vec::with_capacity(LEVELS);
     for l in 0..LEVELS {
         let res = level_resolution(resolution, l) as f64;
@@ -202,13 +218,15 @@ fn load_raster(path: &Path, bytes: &[u8], resolution: u32) -> Result<ExemplarInk
         let to_user = Affine::scale(1.0 / scale);
         let layers = covs
             .iter()
-            .map(|(color, c)| Layer {
-                color: *color,
-                sdf: Sdf::from_coverage(&resample(c, w, h), to_user).dist,
+            .map(|(color, c)| {
+                let mut sdf = Sdf::from_coverage(&resample(c, w, h), to_user).dist;
+                quantize_sdf(&mut sdf);
+                Layer { color: *color, sdf }
             })
-            .collect();
-        let ink = match &all {
-            Some(c) => Sdf::from_coverage(&resample(c, w, h), to_user).dist,
+            .collect::<Vec<_>>();
+        // Layers stack: the bottom one holds every colour, i.e. all ink.
+        let ink = match layers.first() {
+            Some(l) => l.sdf.clone(),
             None => Grid::new(w, h, 1.0),
         };
         levels.push(InkLevel {

@@ -232,6 +232,67 @@ pub fn build_ribs(spine: &[Point], n: usize, ink: &Grid<f32>, min_half: f64, rea
     ribs
 }
 
+/// The spine extended straight beyond both ends, along its end tangents,
+/// as far as ink lies beyond them: the end ornaments (curls, buds, leaves
+/// past the points the user picked) become part of the parameterized
+/// stroke, and the main branch is straightened towards the ends as
+/// DecoBrush §4.2 describes. Ink counts for an end when it lies ahead of
+/// the end's tangent, within `reach` px of its line, and nearer to the end
+/// point than to any other part of the spine (1 px slack). Returns the
+/// extended polyline and the two extension lengths (start, end), px.
+pub fn extend_to_ink(spine: &[Point], ink: &Grid<f32>, reach: f64) -> (Vec<Point>, [f64; 2]) {
+    let total: f64 = spine.windows(2).map(|w| w[0].distance(w[1])).sum();
+    if spine.len() < 2 || total <= 0.0 {
+        return (spine.to_vec(), [0.0, 0.0]);
+    }
+    let coarse = resample(spine, 64);
+    // Tangents from a chord a few pixels long, for stability.
+    let probe = (total / 4.0).min(8.0);
+    let along = |pts: &[Point]| -> Vec2 {
+        let a = pts[0];
+        let mut acc = 0.0;
+        for w in pts.windows(2) {
+            acc += w[0].distance(w[1]);
+            if acc >= probe {
+                let d = a - w[1];
+                return d / d.hypot().max(1e-12);
+            }
+        }
+        let d = a - pts[pts.len() - 1];
+        d / d.hypot().max(1e-12)
+    };
+    let rev: Vec<Point> = spine.iter().rev().copied().collect();
+    let ends = [(spine[0], along(spine)), (rev[0], along(&rev))];
+    let mut ext = [0.0f64; 2];
+    for y in 0..ink.height() {
+        for x in 0..ink.width() {
+            if ink.get(x, y) >= 0.0 {
+                continue;
+            }
+            let p = Point::new(x as f64 + 0.5, y as f64 + 0.5);
+            for (k, &(e, t)) in ends.iter().enumerate() {
+                let v = p - e;
+                let s = v.dot(t);
+                if s <= ext[k] || v.cross(t).abs() > reach {
+                    continue;
+                }
+                if v.hypot() <= dist_to_polyline(p, &coarse) + 1.0 {
+                    ext[k] = s;
+                }
+            }
+        }
+    }
+    let mut out = Vec::with_capacity(spine.len() + 2);
+    if ext[0] > 0.0 {
+        out.push(ends[0].0 + ends[0].1 * ext[0]);
+    }
+    out.extend_from_slice(spine);
+    if ext[1] > 0.0 {
+        out.push(ends[1].0 + ends[1].1 * ext[1]);
+    }
+    (out, ext)
+}
+
 /// Fraction of the segment `a`–`b` where `sdf < 0`, from 17 samples.
 fn ink_fraction(sdf: &Grid<f32>, a: Point, b: Point) -> f32 {
     let n = 17;
@@ -278,7 +339,9 @@ pub fn features(ribs: &Ribs, ink: &Grid<f32>, layers: &[&Grid<f32>]) -> Vec<Samp
 }
 
 /// The per-pixel stroking orientation and the stroke region of one level.
+/// (Cached as the mask and the orientations of masked pixels only.)
 #[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(into = "SparseOrientation", try_from = "SparseOrientation")]
 pub struct OrientationField {
     /// Unit orientation `ω = [ω_x, ω_y]` per pixel (pixel axes, y down):
     /// the direction of travel along the stroke; `[0, 0]` outside the
@@ -287,6 +350,50 @@ pub struct OrientationField {
     /// The stroke region: pixels covered by the rib quads (outlines pushed
     /// out by the margin).
     pub mask: Grid<bool>,
+}
+
+/// The cached form of an [`OrientationField`]: the mask, and the
+/// orientations of the masked pixels in row-major order.
+#[derive(Clone, Serialize, Deserialize)]
+struct SparseOrientation {
+    #[serde(with = "crate::raster::plain::bits")]
+    mask: Grid<bool>,
+    #[serde(with = "crate::raster::plain::vec")]
+    dirs: Vec<[f32; 2]>,
+}
+
+impl From<OrientationField> for SparseOrientation {
+    fn from(f: OrientationField) -> Self {
+        let dirs = f
+            .dir
+            .data()
+            .iter()
+            .zip(f.mask.data())
+            .filter(|(_, &m)| m)
+            .map(|(d, _)| *d)
+            .collect();
+        SparseOrientation { mask: f.mask, dirs }
+    }
+}
+
+impl TryFrom<SparseOrientation> for OrientationField {
+    type Error = String;
+    fn try_from(s: SparseOrientation) -> Result<Self, String> {
+        let n = s.mask.data().iter().filter(|&&m| m).count();
+        if n != s.dirs.len() {
+            return Err("orientation count does not match the mask".into());
+        }
+        let mut dir = Grid::new(s.mask.width(), s.mask.height(), [0.0f32; 2]);
+        let mut it = s.dirs.into_iter();
+        for (d, &m) in dir.data_mut().iter_mut().zip(s.mask.data()) {
+            if m {
+                if let Some(v) = it.next() {
+                    *d = v;
+                }
+            }
+        }
+        Ok(OrientationField { dir, mask: s.mask })
+    }
 }
 
 /// The direction of travel implied by an outline rib `o − x`: the rib
@@ -482,6 +589,24 @@ mod tests {
         }
         // Half an annulus 30..50: π (50² − 30²) / 2 ≈ 2513 px.
         assert!((2300..2700).contains(&n), "{n}");
+    }
+
+    #[test]
+    fn spines_extend_over_end_ornaments() {
+        // A band from x = 10 to 190 and a spine from 50 to 150: extended to
+        // the band's last pixel centres, 10.5 and 189.5.
+        let ink = band(200, 80, 40.0, 6.0);
+        let spine = [Point::new(50.0, 40.0), Point::new(150.0, 40.0)];
+        let (ext, len) = extend_to_ink(&spine, &ink, 60.0);
+        assert_eq!(ext.len(), 4);
+        assert!(
+            (ext[0].x - 10.5).abs() < 1.0 && (ext[3].x - 189.5).abs() < 1.0,
+            "{ext:?}"
+        );
+        assert!(
+            (len[0] - 39.5).abs() < 1.0 && (len[1] - 39.5).abs() < 1.0,
+            "{len:?}"
+        );
     }
 
     #[test]

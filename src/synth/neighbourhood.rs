@@ -204,8 +204,9 @@ pub struct NeighbourhoodIndex {
     /// Projected neighbourhoods, parallel to `refs`.
     #[serde(with = "crate::raster::plain::vec")]
     pub points: Vec<[f32; PCA_DIMS]>,
-    /// Where each neighbourhood comes from.
-    #[serde(with = "crate::raster::plain::vec")]
+    /// Where each neighbourhood comes from. Not cached: brush styles
+    /// rebuild it from their stroke-region masks (row-major order).
+    #[serde(skip)]
     pub refs: Vec<NeighbourhoodRef>,
     #[serde(skip)]
     tree: OnceLock<Option<ImmutableKdTree<f32, PCA_DIMS>>>,
@@ -397,9 +398,11 @@ mod tests {
             let dr: f32 = (0..PCA_DIMS).map(|k| (pr[k] - pq[k]).powi(2)).sum();
             assert!((dr - brute).abs() < 1e-5);
         }
-        // Round trip through the cache format keeps it searchable.
+        // Round trip through the cache format keeps it searchable (the
+        // refs are restored by the owner).
         let bytes = postcard::to_stdvec(&index).unwrap();
-        let back: NeighbourhoodIndex = postcard::from_bytes(&bytes).unwrap();
+        let mut back: NeighbourhoodIndex = postcard::from_bytes(&bytes).unwrap();
+        back.refs = index.refs.clone();
         assert_eq!(back.nearest(&data[17]), index.nearest(&data[17]));
         assert!(NeighbourhoodIndex::new(pca, vec![], vec![])
             .nearest(&data[0])
