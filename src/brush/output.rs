@@ -102,16 +102,115 @@ pub fn smooth(g: &Grid<f32>) -> Grid<f32> {
     })
 }
 
+/// The 4-connected components of a mask, as lists of pixel indices
+/// (row-major), in scan order.
+pub fn components(mask: &Grid<bool>) -> Vec<Vec<usize>> {
+    let (w, h) = (mask.width(), mask.height());
+    let mut seen = vec![false; w * h];
+    let mut out = Vec::new();
+    for start in 0..w * h {
+        if seen[start] || !mask.data()[start] {
+            continue;
+        }
+        seen[start] = true;
+        let mut comp = vec![start];
+        let mut k = 0;
+        while let Some(&i) = comp.get(k) {
+            k += 1;
+            let (x, y) = (i % w, i / w);
+            let mut visit = |j: usize| {
+                if !seen[j] && mask.data()[j] {
+                    seen[j] = true;
+                    comp.push(j);
+                }
+            };
+            if x > 0 {
+                visit(i - 1);
+            }
+            if x + 1 < w {
+                visit(i + 1);
+            }
+            if y > 0 {
+                visit(i - w);
+            }
+            if y + 1 < h {
+                visit(i + w);
+            }
+        }
+        out.push(comp);
+    }
+    out
+}
+
+/// Smallest ink component counted as a drawn element, px² (the tracer's
+/// default `min_area`: smaller ones are rasterization specks).
+pub const SPECK: usize = 4;
+
+/// The area (finest px²) of the smallest ink component of any exemplar of
+/// the style (specks under [`SPECK`] aside): ornament pieces smaller than
+/// this are synthesis debris.
+pub fn smallest_exemplar_component(style: &BrushStyle) -> usize {
+    style
+        .exemplars
+        .iter()
+        .filter_map(|e| e.finest())
+        .flat_map(|lv| {
+            components(&lv.ink.ink.map(|d| d < 0.0))
+                .into_iter()
+                .map(|c| c.len())
+        })
+        .filter(|&n| n >= SPECK)
+        .min()
+        .unwrap_or(SPECK)
+}
+
+/// The final per-layer canvas SDFs of a query, bottom layer first, with
+/// their colours: smoothed, and with debris removed — ink components
+/// smaller than the exemplars' smallest, except pieces of at least an
+/// eighth of that on the spine's core band.
+pub fn final_layers(style: &BrushStyle, r: &QueryResult) -> Vec<(Color, Grid<f32>)> {
+    let mut layers: Vec<(Color, Grid<f32>)> = palette(style)
+        .into_iter()
+        .map(|c| (c, smooth(&layer_sdf(style, r, Some(c)))))
+        .collect();
+    let Some((_, first)) = layers.first() else {
+        return layers;
+    };
+    let (w, h) = (first.width(), first.height());
+    let ink = Grid::from_fn(w, h, |x, y| layers.iter().any(|(_, g)| g.get(x, y) < 0.0));
+    let min = smallest_exemplar_component(style);
+    // The spine's core band (a quarter width): a piece there of at least
+    // an eighth of the smallest exemplar piece is part of the ornament's
+    // body, broken off or not, and stays.
+    let to_px = r.canvas.to_pixel(1.0);
+    let spine: Vec<kurbo::Point> = r.spine.samples.iter().map(|s| to_px * s.pos).collect();
+    let core = 0.25 * r.spine.width * r.canvas.px_per_unit;
+    let on_core = |i: usize| {
+        let p = kurbo::Point::new((i % w) as f64 + 0.5, (i / w) as f64 + 0.5);
+        spine.iter().any(|q| q.distance(p) <= core)
+    };
+    for comp in components(&ink) {
+        if comp.len() >= min || (8 * comp.len() >= min && comp.iter().any(|&i| on_core(i))) {
+            continue;
+        }
+        for (_, g) in &mut layers {
+            for &i in &comp {
+                if let Some(v) = g.data_mut().get_mut(i) {
+                    *v = v.max(0.5);
+                }
+            }
+        }
+    }
+    layers
+}
+
 /// Traces a synthesized query into one group of filled shapes, bottom
 /// layer first.
 pub fn trace_query(style: &BrushStyle, r: &QueryResult, id: String, opts: &TraceOptions) -> Group {
     let to_user = r.canvas.to_user();
     let mut shapes = Vec::new();
-    for color in palette(style) {
-        let sdf = Sdf {
-            dist: smooth(&layer_sdf(style, r, Some(color))),
-            to_user,
-        };
+    for (color, dist) in final_layers(style, r) {
+        let sdf = Sdf { dist, to_user };
         for p in trace_sdf(&sdf, opts) {
             shapes.push(Shape {
                 fill_rule: FillRule::NonZero,
@@ -130,9 +229,13 @@ pub fn prepared_spines(
 ) -> Result<(Vec<QuerySpine>, Vec<String>, Vec<String>)> {
     let set = query::spines(sketch, &opts.query)?;
     if set.spines.is_empty() {
+        let skipped = match set.warnings.first() {
+            Some(w) => format!(" ({} skipped; first: {w})", set.warnings.len()),
+            None => String::new(),
+        };
         return Err(Error::invalid(
             &sketch.path,
-            "no open paths to brush along (draw stroked paths without fill)",
+            format!("no open paths to brush along (draw stroked paths without fill){skipped}"),
         ));
     }
     let mut spines: Vec<QuerySpine> = Vec::with_capacity(set.spines.len());
@@ -161,7 +264,26 @@ pub fn brush_sketch(
     let (spines, warnings, notes) = prepared_spines(sketch, opts)?;
     let results: Vec<QueryResult> = spines
         .par_iter()
-        .map(|q| brush_query(style, q, opts))
+        .map(|q| {
+            brush_query(style, q, opts).map_err(|e| match e {
+                Error::TooLarge {
+                    width,
+                    height,
+                    limit,
+                    ..
+                } => Error::TooLarge {
+                    path: format!("{}: query {}", sketch.path.display(), q.query_id).into(),
+                    width,
+                    height,
+                    limit,
+                },
+                Error::Degenerate { subject, reason } => Error::Degenerate {
+                    subject: format!("{}: {subject}", sketch.path.display()),
+                    reason,
+                },
+                other => other,
+            })
+        })
         .collect::<Result<Vec<_>>>()?;
     let trace = TraceOptions::default();
     let ppu = results

@@ -110,21 +110,31 @@ pub fn start_level(style: &BrushStyle, ew: f64) -> usize {
         .unwrap_or(e.levels.len().saturating_sub(1))
 }
 
-/// The style's mean rib width, finest px.
+/// Percentile of the style's rib widths taken as "the exemplar width".
+pub const WIDTH_PERCENTILE: f64 = 0.8;
+
+/// The style's exemplar width, finest px: the [`WIDTH_PERCENTILE`] of all
+/// rib widths (ribs reach the farthest ink, leaves and curls included, so
+/// a high percentile keeps the ornament within the stroke the designer
+/// drew).
 pub fn exemplar_width(style: &BrushStyle) -> Result<f64> {
-    let ws: Vec<f64> = style
+    let mut ws: Vec<f64> = style
         .exemplars
         .iter()
         .flat_map(|e| e.ribs.widths())
+        .filter(|w| w.is_finite() && *w > 0.0)
         .collect();
-    let w = ws.iter().sum::<f64>() / ws.len().max(1) as f64;
-    if ws.is_empty() || !(w.is_finite() && w > 0.0) {
-        return Err(Error::degenerate(
+    ws.sort_by(f64::total_cmp);
+    let k = ((ws.len() as f64 - 1.0) * WIDTH_PERCENTILE)
+        .round()
+        .max(0.0) as usize;
+    match ws.get(k) {
+        Some(&w) => Ok(w),
+        None => Err(Error::degenerate(
             format!("style {}", style.name),
             "its exemplars have no rib widths",
-        ));
+        )),
     }
-    Ok(w)
 }
 
 /// An exemplar's ribs resampled at a given spacing, finest px.
@@ -155,7 +165,7 @@ pub fn resample_ribs(style: &BrushStyle, e: usize, h: f64) -> Option<Resampled> 
         arc[i] = arc[i - 1] + p(r.spine[i]).distance(p(r.spine[i - 1]));
     }
     let len = arc[n - 1];
-    let m = ((len / h).round() as usize).max(1) + 1;
+    let m = ((len / h).round() as usize).clamp(1, 100_000) + 1;
     let mut out = Resampled {
         spine: Vec::with_capacity(m),
         left: Vec::with_capacity(m),
@@ -483,6 +493,17 @@ fn run_query(
         return art_brush(style, q, canvas, levels);
     }
     let h = q.spacing * canvas.px_per_unit;
+    // Samples closer than a quarter exemplar pixel: a stroke far wider
+    // than it is long, or so short it was sampled below its width's pace.
+    if !(h.is_finite() && h >= 0.25) {
+        return Err(Error::degenerate(
+            format!("query {}", q.query_id),
+            format!(
+                "too short for its stroke width ({:.3} long, {:.3} wide)",
+                q.length, q.width
+            ),
+        ));
+    }
     let mut ribs = Vec::with_capacity(style.exemplars.len());
     for e in 0..style.exemplars.len() {
         ribs.push(resample_ribs(style, e, h).ok_or_else(|| {
