@@ -26,6 +26,11 @@ demo:
 	    $(BIN) pattern --style $$style $$s -o $(OUT)/pattern/$$n-$$style.svg --preview $(OUT)/pattern/$$n-$$style.png || exit 1; \
 	  done; \
 	done
+	for style in vine scroll doodle; do \
+	  mkdir -p $(OUT)/brush/$$style $(OUT)/brush/$$style-art-brush; \
+	  $(BIN) brush --style $$style samples/brush/*.svg --out-dir $(OUT)/brush/$$style --preview $(OUT)/brush/$$style || exit 1; \
+	  $(BIN) brush --art-brush --style $$style samples/brush/*.svg --out-dir $(OUT)/brush/$$style-art-brush --preview $(OUT)/brush/$$style-art-brush || exit 1; \
+	done
 	@echo "demo outputs (SVG + preview PNG) are in $(OUT)/"
 
 # The whole test suite (heavy tests run optimized: see [profile.test]).
@@ -37,6 +42,7 @@ test: deps
 golden:
 	UPDATE_GOLDEN=1 $(CARGO) test --test trace golden
 	UPDATE_GOLDEN=1 $(CARGO) test --test pattern
+	UPDATE_GOLDEN=1 $(CARGO) test --test brush golden
 	git status --short golden/
 
 # Criterion benchmarks of every pipeline, then the side-by-side with potrace.
