@@ -200,10 +200,17 @@ fn cache_hits_misses_and_rebuilds_corrupt_files() {
             assert_eq!(st, CacheStatus::Hit);
         }
     }
-    // Editing an exemplar changes the key: a miss, not the old analysis.
+    // Editing an exemplar changes the key: a miss, not the old analysis,
+    // and the stale file is replaced, not kept beside the new one.
     std::fs::write(dir.join("b.svg"), exemplar_svg(2.0)).unwrap();
     let (_, st) = BrushStyle::load_with_status(&dir, &opts).unwrap();
     assert_eq!(st, CacheStatus::Miss);
+    let after: Vec<_> = std::fs::read_dir(tmp.path().join("cache"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    assert_eq!(after.len(), 1, "{after:?}");
+    assert_ne!(&after[0], file);
     // Caching off.
     let off = AnalysisOptions {
         use_cache: false,
@@ -263,4 +270,142 @@ fn shipped_brush_styles_pass_the_check_without_warnings() {
         let n = report.matches(".svg:").count();
         assert!((8..=12).contains(&n), "{report}");
     }
+}
+
+/// The exemplar of `exemplar_svg` on a 200×200 canvas, optionally turned a
+/// quarter turn about the centre.
+fn square_exemplar(rotated: bool) -> String {
+    let body = exemplar_svg(0.4)
+        .lines()
+        .filter(|l| !l.starts_with("<svg") && !l.starts_with("</svg"))
+        .collect::<Vec<_>>()
+        .join("\n");
+    let g = if rotated {
+        "<g transform=\"rotate(90 100 100)\">"
+    } else {
+        "<g transform=\"translate(0 50)\">"
+    };
+    let inner = if rotated {
+        format!("<g transform=\"translate(0 50)\">{body}</g>")
+    } else {
+        body
+    };
+    format!(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"200\" height=\"200\">{g}{inner}</g></svg>"
+    )
+}
+
+#[test]
+fn rotating_an_exemplar_rotates_its_orientation_and_neighbourhoods() {
+    let tmp = tempfile::tempdir().unwrap();
+    // Start and end of the band (y + 50 in the square canvas), and their
+    // quarter turn about (100, 100): (x, y) -> (200 - y, x).
+    let (s, e) = ([24.0, 100.0], [170.0, 100.0]);
+    let rot = |p: [f64; 2]| [200.0 - p[1], p[0]];
+    let mut styles = Vec::new();
+    for (name, rotated, s, e) in [("a", false, s, e), ("b", true, rot(s), rot(e))] {
+        let dir = tmp.path().join(name);
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("x.svg"), square_exemplar(rotated)).unwrap();
+        std::fs::write(
+            dir.join("style.toml"),
+            format!(
+                "kind = \"brush\"\nresolution = 128\n[[exemplar]]\nfile = \"x.svg\"\nstart = [{}, {}]\nend = [{}, {}]\n",
+                s[0], s[1], e[0], e[1]
+            ),
+        )
+        .unwrap();
+        let opts = AnalysisOptions {
+            use_cache: false,
+            ..AnalysisOptions::default()
+        };
+        styles.push(BrushStyle::load(&dir, &opts).unwrap());
+    }
+    let (a, b) = (&styles[0], &styles[1]);
+    let (la, lb) = (
+        a.exemplars[0].finest().unwrap(),
+        b.exemplars[0].finest().unwrap(),
+    );
+    assert_eq!((la.width(), la.height()), (128, 128));
+    // Pixel (i, j) turns into (127 − j, i); orientation ω into (−ω_y, ω_x).
+    let (mut both, mut only, mut aligned, mut close) = (0, 0, 0, 0);
+    for j in 0..128 {
+        for i in 0..128 {
+            if !la.orientation.mask.get(i, j) {
+                continue;
+            }
+            let (ri, rj) = (127 - j, i);
+            if !lb.orientation.mask.get(ri, rj) {
+                only += 1;
+                continue;
+            }
+            both += 1;
+            let wa = la.orientation.dir.get(i, j);
+            let wb = lb.orientation.dir.get(ri, rj);
+            if -wa[1] * wb[0] + wa[0] * wb[1] > 10f32.to_radians().cos() {
+                aligned += 1;
+            }
+            let na = a
+                .sampler
+                .sample(&la.ink.ink, [i as f64 + 0.5, j as f64 + 0.5], wa);
+            let nb = b
+                .sampler
+                .sample(&lb.ink.ink, [ri as f64 + 0.5, rj as f64 + 0.5], wb);
+            let worst = na
+                .iter()
+                .zip(&nb)
+                .map(|(x, y)| (x - y).abs())
+                .fold(0.0, f32::max);
+            if worst < 0.15 {
+                close += 1;
+            }
+        }
+    }
+    assert!(both > 500, "{both}");
+    assert!(only * 20 < both, "regions differ: {only} of {both}");
+    assert!(
+        aligned * 100 > both * 95,
+        "orientation: {aligned} of {both}"
+    );
+    assert!(close * 100 > both * 95, "neighbourhoods: {close} of {both}");
+}
+
+#[test]
+fn png_exemplars_are_analysed_too() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("png");
+    std::fs::create_dir_all(&dir).unwrap();
+    // A dark band with a round end on white, 160×80 px.
+    let img = image::RgbImage::from_fn(160, 80, |x, y| {
+        let (px, py) = (x as f64 + 0.5, y as f64 + 0.5);
+        let band = (20.0..130.0).contains(&px) && (py - 40.0).abs() < 6.0;
+        let ball = (px - 134.0).hypot(py - 40.0) < 10.0;
+        if band || ball {
+            image::Rgb([30, 40, 60])
+        } else {
+            image::Rgb([255, 255, 255])
+        }
+    });
+    img.save(dir.join("band.png")).unwrap();
+    std::fs::write(
+        dir.join("style.toml"),
+        "kind = \"brush\"\nresolution = 128\n[[exemplar]]\nfile = \"band.png\"\nstart = [30.0, 40.0]\nend = [125.0, 40.0]\n",
+    )
+    .unwrap();
+    let opts = AnalysisOptions {
+        use_cache: false,
+        ..AnalysisOptions::default()
+    };
+    let st = BrushStyle::load(&dir, &opts).unwrap();
+    let ex = &st.exemplars[0];
+    assert_eq!(ex.size, [160.0, 80.0]);
+    let fine = ex.finest().unwrap();
+    assert_eq!((fine.width(), fine.height()), (128, 64));
+    // Widths along the band: 12 px × 0.8 = 9.6 finest px, within a pixel,
+    // away from the ball; the spine is extended over the ball.
+    let w = ex.ribs.widths();
+    let mid = &w[w.len() / 4..w.len() / 2];
+    assert!(mid.iter().all(|&x| (x - 9.6).abs() < 1.0), "{mid:?}");
+    assert!(ex.extension[1] > 10.0, "{:?}", ex.extension);
+    assert!(st.indexes.iter().all(|i| !i.is_empty()));
 }

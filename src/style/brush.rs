@@ -178,6 +178,12 @@ impl BrushStyle {
             .map_err(|_| Error::invalid(&toml_path, "not UTF-8 text"))?;
         let toml = super::parse(&toml_path, &text)?;
         toml.expect_kind(dir, StyleKind::Brush)?;
+        if toml.exemplar.is_empty() {
+            return Err(Error::invalid(
+                &toml_path,
+                "exemplar: a brush style needs at least one [[exemplar]] table",
+            ));
+        }
         let files: Vec<PathBuf> = toml.exemplar.iter().map(|e| dir.join(&e.file)).collect();
         let key = cache::style_key(&toml_bytes, &files)?;
         let name = style_name(dir);

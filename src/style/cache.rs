@@ -150,7 +150,43 @@ pub fn write(path: &Path, key: &[u8; 32], style: &BrushStyle) -> Result<()> {
     let body = encode(style)
         .map_err(|e| crate::Error::invalid(path, format!("cannot encode the analysis: {e}")))?;
     bytes.extend_from_slice(&body);
-    io::write_atomic(path, &bytes)
+    io::write_atomic(path, &bytes)?;
+    remove_stale(path);
+    Ok(())
+}
+
+/// Removes the style's other cache files (older content or versions) from
+/// `path`'s folder, so edits do not pile up stale analyses. Best effort.
+fn remove_stale(path: &Path) {
+    let (Some(dir), Some(name)) = (path.parent(), path.file_name().and_then(|n| n.to_str())) else {
+        return;
+    };
+    // `NAME-` + 24 hex digits + `.bin`.
+    let Some(stem) = name
+        .strip_suffix(".bin")
+        .and_then(|n| n.get(..n.len().saturating_sub(24)))
+    else {
+        return;
+    };
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let p = entry.path();
+        let Some(other) = p.file_name().and_then(|n| n.to_str()) else {
+            continue;
+        };
+        let is_sibling = other != name
+            && other.len() == name.len()
+            && other.starts_with(stem)
+            && other.ends_with(".bin")
+            && other[stem.len()..other.len() - 4]
+                .bytes()
+                .all(|b| b.is_ascii_hexdigit());
+        if is_sibling {
+            let _ = std::fs::remove_file(&p);
+        }
+    }
 }
 
 /// The style's small fields.

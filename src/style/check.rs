@@ -478,3 +478,43 @@ fn draw_panel(pm: &mut tiny_skia::Pixmap, e: &Exemplar, ox: f32, oy: f32) {
         dot(pm, map(b), [20, 170, 40, 255], 3.5);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two horizontal bands of widths `a` and `b` px (signed distances).
+    fn bands(a: f32, b: f32) -> Grid<f32> {
+        Grid::from_fn(120, 80, |x, y| {
+            let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
+            let ends = (10.0 - px).max(px - 110.0);
+            let d1 = ((py - 20.3).abs() - a / 2.0).max(ends);
+            let d2 = ((py - 55.7).abs() - b / 2.0).max(ends);
+            d1.min(d2)
+        })
+    }
+
+    #[test]
+    fn thin_ink_is_the_area_of_lines_below_the_threshold() {
+        // Threshold 2 coarse px at coarse = 1/4: 8 finest px.
+        let g = bands(5.0, 12.0);
+        let f = thin_ink(&g, 0.25, 2.0);
+        // The 5 px band is about 5/17 of the ink.
+        assert!((f - 5.0 / 17.0).abs() < 0.05, "{f}");
+        assert!(thin_ink(&bands(10.0, 12.0), 0.25, 2.0) < 0.02);
+        assert!(thin_ink(&bands(6.0, 7.0), 0.25, 2.0) > 0.98);
+        assert_eq!(thin_ink(&Grid::new(4, 4, 1.0), 0.25, 2.0), 0.0);
+    }
+
+    #[test]
+    fn off_ink_fraction_measures_length_off_the_ink() {
+        let g = bands(8.0, 8.0);
+        // Along the first band, then straight down across the gap to the
+        // second: 100 px on, 35.4 px of which ~8 px on ink.
+        let spine = [[10.0, 20.3], [110.0, 20.3], [110.0, 55.7]];
+        let f = off_ink_fraction(&spine, &g);
+        let expect = (35.4 - 8.0) / 135.4;
+        assert!((f - expect).abs() < 0.03, "{f} vs {expect}");
+        assert_eq!(off_ink_fraction(&spine[..2], &g), 0.0);
+    }
+}

@@ -65,9 +65,11 @@ pub enum FitPoints {
 pub struct ExemplarToml {
     /// The exemplar file, relative to the style folder.
     pub file: PathBuf,
-    /// Brush: spine start, in the exemplar's user units.
+    /// Brush: spine start, in the exemplar's user units. With a drawn
+    /// `id="spine"` path in the exemplar, the path is the spine and
+    /// `start` only says which of its ends is the start.
     pub start: Option<[f64; 2]>,
-    /// Brush: spine end, in the exemplar's user units.
+    /// Brush: spine end, in the exemplar's user units (given with `start`).
     pub end: Option<[f64; 2]>,
 }
 
@@ -178,12 +180,8 @@ impl StyleToml {
             }
         }
         if self.kind == StyleKind::Brush {
-            if self.exemplar.is_empty() {
-                return bad(
-                    "exemplar",
-                    "a brush style needs at least one [[exemplar]] table".into(),
-                );
-            }
+            // (An empty library is refused by the brush analysis itself, so
+            // other commands report the wrong kind first.)
             for (i, ex) in self.exemplar.iter().enumerate() {
                 for (key, p) in [("start", ex.start), ("end", ex.end)] {
                     if let Some([x, y]) = p {
