@@ -111,6 +111,9 @@ struct BrushArgs {
     /// Draw the art-brush baseline instead (one exemplar stretched along the path).
     #[arg(long)]
     art_brush: bool,
+    /// Refinement sketch: black strokes add ornament, white ones erase it (DecoBrush §5.5).
+    #[arg(long, value_name = "REFINE.svg")]
+    refine: Option<PathBuf>,
     /// Correction iterations per synthesis level (0: graph cut upsampled only).
     #[arg(long, default_value_t = 2, value_name = "N")]
     iterations: usize,
@@ -343,6 +346,7 @@ fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
         let opts = BrushOptions {
             seed: args.seed.wrapping_add(k as u64),
             art_brush: args.art_brush,
+            refine: args.refine.clone(),
             synth: flourish::brush::synth::SynthOptions {
                 iterations: args.iterations,
                 ..Default::default()

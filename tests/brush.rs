@@ -464,3 +464,48 @@ fn bad_input_is_refused_or_skipped_clearly() {
     assert_eq!(out.queries.len(), 1);
     assert!(t.elapsed().as_secs_f64() < 20.0);
 }
+
+#[test]
+fn refinement_erases_under_white_strokes_and_locks_the_rest() {
+    let style = style("doodle");
+    let sk = sketch("s-curve");
+    let plain = brush_sketch(style, &sk, &BrushOptions::default()).unwrap();
+    let refine = root().join("samples/brush/s-curve-refine.svg");
+    let opts = BrushOptions {
+        refine: Some(refine),
+        ..BrushOptions::default()
+    };
+    let refined = brush_sketch(style, &sk, &opts).unwrap();
+    let (a, b) = (&plain.queries[0], &refined.queries[0]);
+    let (ia, ib) = (ink(style, a), ink(style, b));
+    // The white stroke runs from (80, 60) to (120, 100), 24 units wide.
+    let seg = kurbo::Line::new((80.0, 60.0), (120.0, 100.0));
+    let dist = |p: Point| {
+        use kurbo::ParamCurveNearest;
+        seg.nearest(p, 1e-6).distance_sq.sqrt()
+    };
+    let (mut before, mut after, mut changed_far) = (0, 0, 0);
+    for y in 0..ia.height() {
+        for x in 0..ia.width() {
+            let p = at(a, x, y);
+            let d = dist(p);
+            if d < 8.0 {
+                before += ia.get(x, y) as usize;
+                after += ib.get(x, y) as usize;
+            }
+            if d > 60.0 && a.field.coords.get(x, y) != b.field.coords.get(x, y) {
+                let near_add = p.distance(Point::new(320.0, 105.0)) < 60.0;
+                if !near_add {
+                    changed_far += 1;
+                }
+            }
+        }
+    }
+    eprintln!("ink under the eraser: {before} px before, {after} px after; {changed_far} px changed far from the strokes");
+    assert!(before > 0, "the eraser crosses ink");
+    assert!(
+        after * 4 < before,
+        "{after} of {before} px of ink left under the eraser"
+    );
+    assert_eq!(changed_far, 0, "refinement stays inside its mask");
+}

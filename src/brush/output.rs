@@ -254,6 +254,81 @@ pub fn prepared_spines(
     Ok((spines, set.warnings, notes))
 }
 
+/// Applies a refinement sketch to every synthesized query (§5.5): the
+/// sketch is rendered onto each query's canvas; opaque dark pixels add ink,
+/// opaque light ones erase it; the mask is those pixels dilated by 2 px.
+fn refine_all(
+    style: &BrushStyle,
+    results: Vec<QueryResult>,
+    path: &std::path::Path,
+    opts: &BrushOptions,
+) -> Result<Vec<QueryResult>> {
+    let tree = crate::io::load_svg(path)?;
+    let sopts = crate::brush::synth::SynthOptions {
+        seed: opts.seed,
+        ..opts.synth.clone()
+    };
+    let mut out = Vec::with_capacity(results.len());
+    for mut r in results {
+        let (w, h) = (r.canvas.width, r.canvas.height);
+        let Some(mut pixmap) = resvg::tiny_skia::Pixmap::new(w as u32, h as u32) else {
+            out.push(r);
+            continue;
+        };
+        let c = r.canvas.to_pixel(1.0).as_coeffs();
+        let t = resvg::tiny_skia::Transform::from_row(
+            c[0] as f32,
+            c[1] as f32,
+            c[2] as f32,
+            c[3] as f32,
+            c[4] as f32,
+            c[5] as f32,
+        );
+        resvg::render(&tree, t, &mut pixmap.as_mut());
+        let px = pixmap.pixels();
+        // +1 add, −1 erase, 0 untouched.
+        let marks = Grid::from_fn(w, h, |x, y| {
+            let p = px[y * w + x];
+            if p.alpha() < 128 {
+                0i8
+            } else {
+                let l = (p.red() as u32 + p.green() as u32 + p.blue() as u32) * 255
+                    / (3 * p.alpha() as u32).max(1);
+                if l < 128 {
+                    1
+                } else {
+                    -1
+                }
+            }
+        });
+        if marks.data().iter().all(|m| *m == 0) {
+            out.push(r);
+            continue;
+        }
+        let mut target = crate::brush::synth::appearance(style, &r.field);
+        let mask = Grid::from_fn(w, h, |x, y| {
+            (-2isize..=2).any(|dy| {
+                (-2isize..=2).any(|dx| marks.get_or(x as isize + dx, y as isize + dy, 0) != 0)
+            })
+        });
+        for y in 0..h {
+            for x in 0..w {
+                match marks.get(x, y) {
+                    1 => target.set(x, y, -2.0),
+                    -1 => target.set(x, y, PAPER),
+                    _ => {}
+                }
+            }
+        }
+        if let Some(f) = crate::brush::synth::refine(style, &r.levels, &target, &mask, &sopts) {
+            r.energy = crate::brush::synth::energy(style, &f);
+            r.field = f;
+        }
+        out.push(r);
+    }
+    Ok(out)
+}
+
 /// Runs the brush pipeline on every open path of `sketch` (queries in
 /// parallel, results in drawing order) and writes the document.
 pub fn brush_sketch(
@@ -285,6 +360,10 @@ pub fn brush_sketch(
             })
         })
         .collect::<Result<Vec<_>>>()?;
+    let results = match &opts.refine {
+        Some(path) => refine_all(style, results, path, opts)?,
+        None => results,
+    };
     let trace = TraceOptions::default();
     let ppu = results
         .iter()

@@ -45,6 +45,9 @@ pub struct BrushOptions {
     /// (0 = coarsest); `None`: the coarsest level on which the exemplar
     /// strokes are at least [`MIN_SYNTH_WIDTH`] px wide.
     pub start_level: Option<usize>,
+    /// A refinement sketch (§5.5, `--refine`): black strokes add ink,
+    /// white ones erase it; same viewBox as the sketch.
+    pub refine: Option<std::path::PathBuf>,
 }
 
 /// A query's canvas: finest-level pixel `(x, y)` has its centre at sketch
@@ -90,6 +93,9 @@ pub struct QueryResult {
     /// Matched segments (exemplar index, query sample range); empty for the
     /// art-brush baseline.
     pub segments: Vec<(usize, std::ops::Range<usize>)>,
+    /// The corrected field of every synthesis level, coarse to fine (for
+    /// refinement, §5.5); empty for the baseline.
+    pub levels: Vec<Field>,
 }
 
 /// Narrowest mean stroke width (px) at which a level's 5×5 neighbourhoods
@@ -586,13 +592,18 @@ fn run_query(
             energy: synth::energy(style, &init),
             field: init,
             segments,
+            levels: Vec::new(),
         });
     }
     let sopts = SynthOptions {
         seed: opts.seed,
         ..opts.synth.clone()
     };
-    let field = synth::synthesize(style, init, &sopts);
+    let levels = synth::synthesize_levels(style, init, &sopts);
+    let field = levels
+        .last()
+        .cloned()
+        .ok_or_else(|| Error::degenerate("brush", "synthesis produced no level"))?;
     let energy = synth::energy(style, &field);
     Ok(QueryResult {
         spine: q.clone(),
@@ -600,6 +611,7 @@ fn run_query(
         field,
         energy,
         segments,
+        levels,
     })
 }
 
@@ -640,5 +652,6 @@ fn art_brush(
         field,
         energy,
         segments: Vec::new(),
+        levels: Vec::new(),
     })
 }

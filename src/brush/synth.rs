@@ -294,6 +294,17 @@ fn correct_pixel(
 
 /// Runs `opts.iterations` correction iterations on `field` (§5.4.2).
 pub fn correct(style: &BrushStyle, field: &mut Field, opts: &SynthOptions) {
+    correct_in(style, field, opts, None);
+}
+
+/// [`correct`] restricted to the pixels where `only` is true (all when
+/// `None`); the others are locked (§5.5).
+pub fn correct_in(
+    style: &BrushStyle,
+    field: &mut Field,
+    opts: &SynthOptions,
+    only: Option<&Grid<bool>>,
+) {
     let (w, h) = (field.coords.width(), field.coords.height());
     let mut look = appearance(style, field);
     for it in 0..opts.iterations {
@@ -312,6 +323,9 @@ pub fn correct(style: &BrushStyle, field: &mut Field, opts: &SynthOptions) {
                     (ox..w).step_by(2).filter_map(move |x| {
                         let cur = snapshot.coords.get(x, y);
                         cur?;
+                        if only.is_some_and(|m| !m.get(x, y)) {
+                            return None;
+                        }
                         let new = correct_pixel(style, snapshot, look, opts, pass, x, y);
                         (new != cur).then_some((x, y, new))
                     })
@@ -358,13 +372,109 @@ pub fn upsample(style: &BrushStyle, field: &Field) -> Field {
 /// The whole §5.4 pipeline from an initialized coarsest field: correct,
 /// upsample, correct, … up to the finest level of the style.
 pub fn synthesize(style: &BrushStyle, init: Field, opts: &SynthOptions) -> Field {
+    let mut levels = synthesize_levels(style, init, opts);
+    levels.pop().unwrap_or_else(|| Field {
+        level: 0,
+        coords: Grid::new(0, 0, None),
+        orient: Grid::new(0, 0, [0.0; 2]),
+        seam: Grid::new(0, 0, false),
+    })
+}
+
+/// [`synthesize`], keeping the corrected field of every level visited,
+/// coarse to fine.
+pub fn synthesize_levels(style: &BrushStyle, init: Field, opts: &SynthOptions) -> Vec<Field> {
     let levels = style.exemplars.first().map(|e| e.levels.len()).unwrap_or(1);
+    let mut out = Vec::new();
     let mut field = init;
     loop {
         correct(style, &mut field, opts);
         if field.level + 1 >= levels {
-            return field;
+            out.push(field);
+            return out;
         }
-        field = upsample(style, &field);
+        let next = upsample(style, &field);
+        out.push(field);
+        field = next;
     }
+}
+
+/// User-guided refinement (decobrush.txt §5.5). `levels` are a synthesis's
+/// fields coarse to fine; `target` the finest-level appearance the user
+/// asks for (ink SDF, px: the synthesized one with added strokes inked and
+/// erased ones cleared) and `mask` the dilated refined pixels. At the
+/// coarsest level the masked pixels take the nearest exemplar
+/// neighbourhood of the target (no coherence), then every level is
+/// upsampled and corrected inside the mask only; outside it the original
+/// coordinates stay locked.
+pub fn refine(
+    style: &BrushStyle,
+    levels: &[Field],
+    target: &Grid<f32>,
+    mask: &Grid<bool>,
+    opts: &SynthOptions,
+) -> Option<Field> {
+    let first = levels.first()?;
+    let n = levels.len();
+    let down = |k: usize| 1usize << (n - 1 - k);
+    let mask_at = |k: usize, f: &Field| {
+        let d = down(k);
+        Grid::from_fn(f.coords.width(), f.coords.height(), |x, y| {
+            (0..d).any(|j| {
+                (0..d).any(|i| mask.get_or((x * d + i) as isize, (y * d + j) as isize, false))
+            })
+        })
+    };
+    let mut field = first.clone();
+    let m0 = mask_at(0, &field);
+    let d0 = down(0);
+    let mut look = appearance(style, &field);
+    for y in 0..look.height() {
+        for x in 0..look.width() {
+            if m0.get(x, y) {
+                let t = target.get_or(
+                    (x * d0 + d0 / 2) as isize,
+                    (y * d0 + d0 / 2) as isize,
+                    PAPER,
+                );
+                look.set(x, y, t / d0 as f32);
+            }
+        }
+    }
+    let index = style.indexes.get(field.level)?;
+    for y in 0..look.height() {
+        for x in 0..look.width() {
+            if !m0.get(x, y) {
+                continue;
+            }
+            let q = query_neighbourhood(style, &look, &field, x, y);
+            if let Some((r, _)) = index.nearest(&q) {
+                field.coords.set(
+                    x,
+                    y,
+                    Some(Coord {
+                        exemplar: r.exemplar,
+                        x: r.x as f32 + 0.5,
+                        y: r.y as f32 + 0.5,
+                    }),
+                );
+            }
+        }
+    }
+    correct_in(style, &mut field, opts, Some(&m0));
+    for (k, original) in levels.iter().enumerate().skip(1) {
+        let mut next = upsample(style, &field);
+        let mk = mask_at(k, original);
+        for y in 0..next.coords.height() {
+            for x in 0..next.coords.width() {
+                if !mk.get(x, y) {
+                    next.coords
+                        .set(x, y, original.coords.get_or(x as isize, y as isize, None));
+                }
+            }
+        }
+        correct_in(style, &mut next, opts, Some(&mk));
+        field = next;
+    }
+    Some(field)
 }
