@@ -509,3 +509,51 @@ fn refinement_erases_under_white_strokes_and_locks_the_rest() {
     );
     assert_eq!(changed_far, 0, "refinement stays inside its mask");
 }
+
+#[test]
+fn cli_writes_variations_and_fails_cleanly() {
+    let bin = env!("CARGO_BIN_EXE_flourish");
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("o.svg");
+    let cache = std::env::temp_dir().join("flourish-test-cache");
+    let run = |args: &[&str]| std::process::Command::new(bin).args(args).output().unwrap();
+    let sample = root().join("samples/brush/short.svg");
+    let r = run(&[
+        "brush",
+        "--style",
+        "doodle",
+        "--styles",
+        root().join("styles").to_str().unwrap(),
+        "--cache",
+        cache.to_str().unwrap(),
+        sample.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--variations",
+        "2",
+    ]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let a = std::fs::read_to_string(dir.path().join("o-1.svg")).unwrap();
+    let b = std::fs::read_to_string(dir.path().join("o-2.svg")).unwrap();
+    assert!(a.contains("<g id=\"short\""), "{a}");
+    assert_ne!(a, b, "two variations differ");
+    let (_d, empty) = temp_sketch(r##"<rect x="10" y="10" width="50" height="50" fill="#000"/>"##);
+    let r = run(&[
+        "brush",
+        "--style",
+        "doodle",
+        "--cache",
+        cache.to_str().unwrap(),
+        empty.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(r.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("s.svg") && err.contains("no open paths"),
+        "{err}"
+    );
+    assert!(!out.exists(), "no output on failure");
+}
