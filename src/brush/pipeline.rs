@@ -295,6 +295,10 @@ fn orient_of(
     (l > 0.0).then(|| [(wx / l) as f32, (wy / l) as f32])
 }
 
+/// Pixels (at the start level) by which the seam regions, where the ANN
+/// search runs, extend beyond the overlaps of matched segments.
+pub const SEAM_MARGIN: isize = 3;
+
 /// A coordinate field from several warped exemplar segments: owners,
 /// orientation and seam mask.
 fn compose(
@@ -329,10 +333,12 @@ fn compose(
             }
             let covering = fields.iter().filter(|(_, g)| g.get(x, y).is_some()).count();
             if covering > 1 {
-                for (dx, dy) in [(0isize, 0isize), (1, 0), (-1, 0), (0, 1), (0, -1)] {
-                    let (nx, ny) = (x as isize + dx, y as isize + dy);
-                    if nx >= 0 && ny >= 0 && (nx as usize) < w && (ny as usize) < h {
-                        seam.set(nx as usize, ny as usize, true);
+                for dy in -SEAM_MARGIN..=SEAM_MARGIN {
+                    for dx in -SEAM_MARGIN..=SEAM_MARGIN {
+                        let (nx, ny) = (x as isize + dx, y as isize + dy);
+                        if nx >= 0 && ny >= 0 && (nx as usize) < w && (ny as usize) < h {
+                            seam.set(nx as usize, ny as usize, true);
+                        }
                     }
                 }
             }
