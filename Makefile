@@ -33,6 +33,11 @@ demo:
 	    $(BIN) fill --style $$style $$s -o $(OUT)/fill/$$n-$$style.svg --preview $(OUT)/fill/$$n-$$style.png || exit 1; \
 	  done; \
 	done
+	for style in vine scroll doodle; do \
+	  mkdir -p $(OUT)/brush/$$style $(OUT)/brush/$$style-art-brush; \
+	  $(BIN) brush --style $$style samples/brush/*.svg --out-dir $(OUT)/brush/$$style --preview $(OUT)/brush/$$style || exit 1; \
+	  $(BIN) brush --art-brush --style $$style samples/brush/*.svg --out-dir $(OUT)/brush/$$style-art-brush --preview $(OUT)/brush/$$style-art-brush || exit 1; \
+	done
 	@echo "demo outputs (SVG + preview PNG) are in $(OUT)/"
 
 # The whole test suite (heavy tests run optimized: see [profile.test]).
@@ -45,6 +50,7 @@ golden:
 	UPDATE_GOLDEN=1 $(CARGO) test --test trace golden
 	UPDATE_GOLDEN=1 $(CARGO) test --test pattern
 	UPDATE_GOLDEN=1 $(CARGO) test --test fill golden
+	UPDATE_GOLDEN=1 $(CARGO) test --test brush golden
 	git status --short golden/
 
 # Criterion benchmarks of every pipeline, then the side-by-side with potrace.

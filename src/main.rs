@@ -40,6 +40,8 @@ enum Command {
     Pattern(PatternArgs),
     /// Fill closed shapes with an art pattern synthesized from a tile.
     Fill(FillArgs),
+    /// Grow structured ornament of a brush style along open paths (DecoBrush).
+    Brush(BrushArgs),
     /// Compare two SVGs by rendering; exit 1 when they differ beyond --tolerance.
     Diff(DiffArgs),
     /// Style libraries: analyse, report and draw diagnostics.
@@ -109,6 +111,46 @@ struct FillArgs {
     /// Tile raster size in pixels (longest side), overriding the style's.
     #[arg(long, value_name = "PX")]
     resolution: Option<u32>,
+}
+
+#[derive(Args)]
+struct BrushArgs {
+    /// Sketch SVGs whose stroked open paths are the queries.
+    #[arg(required = true, value_name = "SKETCH.svg")]
+    sketches: Vec<PathBuf>,
+    /// Brush style name (a folder of the styles directory) or folder path.
+    #[arg(long, default_value = "vine")]
+    style: String,
+    /// Styles directory (default: the shipped styles).
+    #[arg(long, value_name = "DIR")]
+    styles: Option<PathBuf>,
+    /// Style analysis cache folder.
+    #[arg(long, value_name = "DIR")]
+    cache: Option<PathBuf>,
+    /// Output SVG (`-` for standard output).
+    #[arg(short = 'o', long = "output", value_name = "OUT.svg")]
+    output: Option<PathBuf>,
+    /// Output folder for several sketches.
+    #[arg(long, value_name = "DIR", conflicts_with = "output")]
+    out_dir: Option<PathBuf>,
+    /// Also render a PNG preview (a folder with --out-dir).
+    #[arg(long, value_name = "PNG")]
+    preview: Option<PathBuf>,
+    /// Seed of the choices among near-equal candidates.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Write N alternatives OUT-1.svg … OUT-N.svg (seeds seed … seed+N−1).
+    #[arg(long, default_value_t = 1, value_name = "N")]
+    variations: u32,
+    /// Draw the art-brush baseline instead (one exemplar stretched along the path).
+    #[arg(long)]
+    art_brush: bool,
+    /// Refinement sketch: black strokes add ornament, white ones erase it (DecoBrush §5.5).
+    #[arg(long, value_name = "REFINE.svg")]
+    refine: Option<PathBuf>,
+    /// Correction iterations per synthesis level (0: graph cut upsampled only).
+    #[arg(long, default_value_t = 2, value_name = "N")]
+    iterations: usize,
 }
 
 #[derive(Args)]
@@ -237,6 +279,7 @@ fn run(cli: Cli) -> Result<(), Failure> {
         Command::Trace(args) => run_trace(args, cli.quiet),
         Command::Pattern(args) => run_pattern(args, cli.quiet, cli.verbose),
         Command::Fill(args) => run_fill(args, cli.quiet, cli.verbose),
+        Command::Brush(args) => run_brush(args, cli.quiet, cli.verbose),
         Command::Diff(args) => run_diff(args, cli.quiet),
         Command::Style(StyleArgs {
             command: StyleCommand::Check(args),
@@ -350,6 +393,103 @@ fn run_fill(args: FillArgs, quiet: bool, verbose: bool) -> Result<(), Failure> {
 
 /// Runs `job` on one input (`-o`) or a batch (`--out-dir`, in parallel with
 /// a progress bar), writing each SVG and optional preview atomically.
+fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure> {
+    use flourish::brush::{output::brush_sketch, pipeline::BrushOptions};
+    use flourish::style::brush::{AnalysisOptions, BrushStyle};
+    if args.variations == 0 || args.variations > 100 {
+        return Err(Failure::Usage("--variations must be in 1..=100".into()));
+    }
+    if args.variations > 1
+        && (args.output.is_none() || args.output.as_deref() == Some(Path::new("-")))
+    {
+        return Err(Failure::Usage(
+            "--variations needs -o OUT.svg (a file)".into(),
+        ));
+    }
+    let styles = args
+        .styles
+        .clone()
+        .unwrap_or_else(flourish::style::default_styles_dir);
+    let dir = flourish::style::resolve(&args.style, &styles)?;
+    let analysis = AnalysisOptions {
+        cache_dir: args.cache.clone(),
+        ..AnalysisOptions::default()
+    };
+    let style = BrushStyle::load(&dir, &analysis)?;
+    for k in 0..args.variations {
+        let opts = BrushOptions {
+            seed: args.seed.wrapping_add(k as u64),
+            art_brush: args.art_brush,
+            refine: args.refine.clone(),
+            synth: flourish::brush::synth::SynthOptions {
+                iterations: args.iterations,
+                ..Default::default()
+            },
+            ..BrushOptions::default()
+        };
+        let job = |sketch: &Path| -> Result<String, Error> {
+            let sk = flourish::sketch::load(sketch)?;
+            if verbose {
+                for note in &sk.notes {
+                    eprintln!("flourish: {}: {note}", sketch.display());
+                }
+            }
+            let out = brush_sketch(&style, &sk, &opts)?;
+            if !quiet {
+                for w in &out.warnings {
+                    eprintln!("flourish: warning: {w}");
+                }
+            }
+            if verbose {
+                for n in &out.notes {
+                    eprintln!("flourish: {n}");
+                }
+                for (i, q) in out.queries.iter().enumerate() {
+                    eprintln!(
+                        "flourish: {}: query {} ({}): {} segments, canvas {}×{} px, energy {:.4}",
+                        sketch.display(),
+                        i + 1,
+                        q.spine.query_id,
+                        q.segments.len(),
+                        q.canvas.width,
+                        q.canvas.height,
+                        q.energy
+                    );
+                }
+            }
+            Ok(out.document.to_svg())
+        };
+        let suffixed = |p: &Path| -> PathBuf {
+            if args.variations == 1 {
+                return p.to_path_buf();
+            }
+            let stem = p.file_stem().unwrap_or_default().to_string_lossy();
+            let ext = p
+                .extension()
+                .map(|e| format!(".{}", e.to_string_lossy()))
+                .unwrap_or_default();
+            p.with_file_name(format!("{stem}-{}{ext}", k + 1))
+        };
+        let output = args.output.as_deref().map(suffixed);
+        let preview = args.preview.as_deref().map(|p| {
+            if args.out_dir.is_some() {
+                p.to_path_buf()
+            } else {
+                suffixed(p)
+            }
+        });
+        run_jobs(
+            &args.sketches,
+            output.as_deref(),
+            args.out_dir.as_deref(),
+            preview.as_deref(),
+            quiet,
+            &job,
+        )?;
+    }
+    Ok(())
+}
+
 fn run_jobs(
     inputs: &[PathBuf],
     output: Option<&Path>,

@@ -13,6 +13,11 @@
 //! - [`graphcut`]: §5.3 seams between overlapping warped segments, an exact
 //!   s–t minimum cut of Eq. 1–2 (oracle: brute force on tiny grids), on
 //!   the Boykov–Kolmogorov max-flow of [`maxflow`] (oracle: Dinic);
+//! - [`synth`]: §5.4 hierarchical synthesis of exemplar coordinates
+//!   (oriented-neighbourhood correction, coordinate upsampling);
+//! - [`pipeline`]: the stages chained for one query, on its own canvas;
+//! - [`output`]: per-layer SDFs through the coordinates, traced to one
+//!   `<g>` per query;
 //! - [`baseline`]: the "art brush" reference, one exemplar stretched along
 //!   the whole query.
 
@@ -21,4 +26,7 @@ pub mod baseline;
 pub mod graphcut;
 pub mod matching;
 pub mod maxflow;
+pub mod output;
+pub mod pipeline;
 pub mod query;
+pub mod synth;

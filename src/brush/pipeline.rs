@@ -1,0 +1,663 @@
+//! The `flourish brush` pipeline for one sketch (decobrush.txt §5–7):
+//! query spines → piecewise matching → ARAP per segment → coordinate fields
+//! at the coarsest level → graph-cut seams in the overlaps → hierarchical
+//! synthesis over the style's three levels → per-layer SDFs on the canvas
+//! → Bézier outlines, one `<g>` per query ([`super::output`]).
+//!
+//! **Canvas scale.** Each query gets its own canvas around its spine whose
+//! finest pixels are the exemplars' finest pixels: `px_per_unit = W_e / W_q`
+//! with `W_e` the style's mean rib width (finest px) and `W_q` the query's
+//! stroke width (sketch units), so the ornament is as wide as the stroke.
+//! Level `l` of the canvas is the finest divided by `2^(L−1−l)`.
+//!
+//! **Branching** (§7). A stroke whose start lies on an earlier stroke (within
+//! half its width of the earlier spine) grows out of it: its start is not
+//! treated as an end by the matching, so no end ornament is forced there.
+
+use super::arap::{rasterize_coords, Arap, RibMesh};
+use super::baseline::art_brush_coords;
+use super::graphcut::{seam, Cover, Label, SeamParams};
+use super::matching::{match_query, MatchOptions, SampleFeature, SpineFeatures};
+use super::query::{self, QueryOptions, QuerySpine};
+use super::synth::{self, Coord, Field, SynthOptions};
+use crate::error::{Error, Result};
+use crate::raster::Grid;
+use crate::style::brush::BrushStyle;
+use kurbo::{Affine, Point, Vec2};
+
+/// Everything the pipeline can be told.
+#[derive(Clone, Debug, Default)]
+pub struct BrushOptions {
+    /// Query spine resampling.
+    pub query: QueryOptions,
+    /// Piecewise matching (its `seed` is overwritten by [`Self::seed`]).
+    pub matching: MatchOptions,
+    /// Synthesis (its `seed` is overwritten by [`Self::seed`]).
+    pub synth: SynthOptions,
+    /// Seam energy weights.
+    pub seams: SeamParams,
+    /// Seed of every choice among near-equal candidates.
+    pub seed: u64,
+    /// Replace matching, ARAP, seams and synthesis by the art-brush
+    /// baseline: the first exemplar stretched along the whole query.
+    pub art_brush: bool,
+    /// Pyramid level at which the graph cut initializes the synthesis
+    /// (0 = coarsest); `None`: the coarsest level on which the exemplar
+    /// strokes are at least [`MIN_SYNTH_WIDTH`] px wide.
+    pub start_level: Option<usize>,
+    /// A refinement sketch (§5.5, `--refine`): black strokes add ink,
+    /// white ones erase it; same viewBox as the sketch.
+    pub refine: Option<std::path::PathBuf>,
+}
+
+/// A query's canvas: finest-level pixel `(x, y)` has its centre at sketch
+/// point `origin + (x + ½, y + ½) / px_per_unit`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Canvas {
+    /// Sketch point at the canvas's top-left corner.
+    pub origin: Point,
+    /// Finest-level canvas pixels per sketch unit.
+    pub px_per_unit: f64,
+    /// Finest-level width, px.
+    pub width: usize,
+    /// Finest-level height, px.
+    pub height: usize,
+    /// Finest over coarsest pixel size (`2^(levels − 1)`).
+    pub factor: usize,
+}
+
+impl Canvas {
+    /// Canvas pixel coordinates at level scale `s` (1 = finest) of a
+    /// sketch point.
+    pub fn to_pixel(&self, s: f64) -> Affine {
+        Affine::scale(self.px_per_unit * s) * Affine::translate(-self.origin.to_vec2())
+    }
+
+    /// Sketch coordinates of a finest-level pixel-space point.
+    pub fn to_user(&self) -> Affine {
+        Affine::translate(self.origin.to_vec2()) * Affine::scale(1.0 / self.px_per_unit)
+    }
+}
+
+/// One query after synthesis.
+#[derive(Clone, Debug)]
+pub struct QueryResult {
+    /// The query spine (after branching adjustments of its features).
+    pub spine: QuerySpine,
+    /// Its canvas.
+    pub canvas: Canvas,
+    /// The synthesized coordinate field at the finest level.
+    pub field: Field,
+    /// The synthesis energy of the final field ([`synth::energy`]).
+    pub energy: f64,
+    /// Matched segments (exemplar index, query sample range); empty for the
+    /// art-brush baseline.
+    pub segments: Vec<(usize, std::ops::Range<usize>)>,
+    /// The corrected field of every synthesis level, coarse to fine (for
+    /// refinement, §5.5); empty for the baseline.
+    pub levels: Vec<Field>,
+}
+
+/// Narrowest mean stroke width (px) at which a level's 5×5 neighbourhoods
+/// still resolve the ornament's structure: on coarser levels a stroke is a
+/// few pixels across, its lines sub-pixel, and correction trades them for
+/// paper.
+pub const MIN_SYNTH_WIDTH: f64 = 8.0;
+
+/// The coarsest level whose mean stroke width is at least
+/// [`MIN_SYNTH_WIDTH`] px (`ew`: the mean width at the finest level).
+pub fn start_level(style: &BrushStyle, ew: f64) -> usize {
+    let Some(e) = style.exemplars.first() else {
+        return 0;
+    };
+    e.levels
+        .iter()
+        .position(|l| ew * l.scale >= MIN_SYNTH_WIDTH)
+        .unwrap_or(e.levels.len().saturating_sub(1))
+}
+
+/// Percentile of the style's rib widths taken as "the exemplar width".
+pub const WIDTH_PERCENTILE: f64 = 0.8;
+
+/// The style's exemplar width, finest px: the [`WIDTH_PERCENTILE`] of all
+/// rib widths (ribs reach the farthest ink, leaves and curls included, so
+/// a high percentile keeps the ornament within the stroke the designer
+/// drew).
+pub fn exemplar_width(style: &BrushStyle) -> Result<f64> {
+    let mut ws: Vec<f64> = style
+        .exemplars
+        .iter()
+        .flat_map(|e| e.ribs.widths())
+        .filter(|w| w.is_finite() && *w > 0.0)
+        .collect();
+    ws.sort_by(f64::total_cmp);
+    let k = ((ws.len() as f64 - 1.0) * WIDTH_PERCENTILE)
+        .round()
+        .max(0.0) as usize;
+    match ws.get(k) {
+        Some(&w) => Ok(w),
+        None => Err(Error::degenerate(
+            format!("style {}", style.name),
+            "its exemplars have no rib widths",
+        )),
+    }
+}
+
+/// An exemplar's ribs resampled at a given spacing, finest px.
+#[derive(Clone, Debug)]
+pub struct Resampled {
+    /// Spine points.
+    pub spine: Vec<Point>,
+    /// Left outline points.
+    pub left: Vec<Point>,
+    /// Right outline points.
+    pub right: Vec<Point>,
+    /// Ink fraction across each rib (appearance descriptor).
+    pub ink: Vec<f64>,
+}
+
+/// Resamples exemplar `e`'s ribs at arc-length spacing `h` (finest px),
+/// linearly interpolating spine, outline points and rib ink.
+pub fn resample_ribs(style: &BrushStyle, e: usize, h: f64) -> Option<Resampled> {
+    let ex = style.exemplars.get(e)?;
+    let r = &ex.ribs;
+    let n = r.len();
+    if n < 2 || ex.features.len() != n || h.is_nan() || h <= 0.0 {
+        return None;
+    }
+    let p = |v: [f64; 2]| Point::new(v[0], v[1]);
+    let mut arc = vec![0.0; n];
+    for i in 1..n {
+        arc[i] = arc[i - 1] + p(r.spine[i]).distance(p(r.spine[i - 1]));
+    }
+    let len = arc[n - 1];
+    let m = ((len / h).round() as usize).clamp(1, 100_000) + 1;
+    let mut out = Resampled {
+        spine: Vec::with_capacity(m),
+        left: Vec::with_capacity(m),
+        right: Vec::with_capacity(m),
+        ink: Vec::with_capacity(m),
+    };
+    for k in 0..m {
+        let s = len * k as f64 / (m - 1) as f64;
+        let i = arc.partition_point(|&a| a <= s).clamp(1, n - 1);
+        let (a, b) = (arc[i - 1], arc[i]);
+        let t = if b > a {
+            ((s - a) / (b - a)).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        out.spine.push(p(r.spine[i - 1]).lerp(p(r.spine[i]), t));
+        out.left.push(p(r.left[i - 1]).lerp(p(r.left[i]), t));
+        out.right.push(p(r.right[i - 1]).lerp(p(r.right[i]), t));
+        let ink = ex.features[i - 1].ink as f64 * (1.0 - t) + ex.features[i].ink as f64 * t;
+        out.ink.push(ink);
+    }
+    Some(out)
+}
+
+/// The matching features of resampled exemplar ribs, in sketch units
+/// (`scale` sketch units per finest px).
+fn exemplar_features(r: &Resampled, scale: f64, mean_width: f64) -> SpineFeatures {
+    let pts: Vec<Point> = r
+        .spine
+        .iter()
+        .map(|q| (q.to_vec2() * scale).to_point())
+        .collect();
+    let len = query::polyline_length(&pts);
+    let samples = query::features(&pts, mean_width * scale, len)
+        .into_iter()
+        .enumerate()
+        .map(|(i, s)| SampleFeature {
+            turning: s.turning,
+            width: r.left[i].distance(r.right[i]) * scale,
+            dist_start: s.dist_start,
+            dist_end: s.dist_end,
+        })
+        .collect();
+    SpineFeatures {
+        samples,
+        appearance: r.ink.iter().map(|&v| vec![v]).collect(),
+    }
+}
+
+/// The canvas of a query spine: its bounding box grown by one stroke width,
+/// at `W_e / W_q` finest pixels per unit, a whole number of coarsest
+/// pixels; checked against the canvas limits before anything is allocated.
+pub fn canvas_for(q: &QuerySpine, ew: f64, factor: usize) -> Result<Canvas> {
+    let ppu = ew / q.width;
+    let (mut x0, mut y0, mut x1, mut y1) = (f64::MAX, f64::MAX, f64::MIN, f64::MIN);
+    for s in &q.samples {
+        (x0, y0) = (x0.min(s.pos.x), y0.min(s.pos.y));
+        (x1, y1) = (x1.max(s.pos.x), y1.max(s.pos.y));
+    }
+    let m = q.width;
+    let f = factor.max(1) as f64;
+    let cw = ((x1 - x0 + 2.0 * m) * ppu / f).ceil();
+    let ch = ((y1 - y0 + 2.0 * m) * ppu / f).ceil();
+    let what = std::path::Path::new(if q.query_id.is_empty() {
+        "query"
+    } else {
+        &q.query_id
+    });
+    if !(cw.is_finite() && ch.is_finite() && cw >= 1.0 && ch >= 1.0) {
+        return Err(Error::invalid(what, "the stroke gives an empty canvas"));
+    }
+    crate::io::check_canvas(
+        what,
+        (cw * f).min(u64::MAX as f64) as u64,
+        (ch * f).min(u64::MAX as f64) as u64,
+    )?;
+    Ok(Canvas {
+        origin: Point::new(x0 - m, y0 - m),
+        px_per_unit: ppu,
+        width: cw as usize * factor,
+        height: ch as usize * factor,
+        factor,
+    })
+}
+
+/// The query orientation ω^q of a coordinate field from one warped
+/// exemplar: `ω^q ∝ J⁻¹ ω^e` with `J = ∂μ/∂p` by finite differences.
+fn orient_of(
+    style: &BrushStyle,
+    level: usize,
+    e: u32,
+    g: &Grid<Option<Point>>,
+    x: usize,
+    y: usize,
+) -> Option<[f32; 2]> {
+    let at = |dx: isize, dy: isize| g.get_or(x as isize + dx, y as isize + dy, None);
+    let c = at(0, 0)?;
+    let diff =
+        |a: Option<Point>, b: Option<Point>, span: f64| -> Option<Vec2> { Some((a? - b?) / span) };
+    let jx = diff(at(1, 0), at(-1, 0), 2.0)
+        .or_else(|| diff(at(1, 0), Some(c), 1.0))
+        .or_else(|| diff(Some(c), at(-1, 0), 1.0))?;
+    let jy = diff(at(0, 1), at(0, -1), 2.0)
+        .or_else(|| diff(at(0, 1), Some(c), 1.0))
+        .or_else(|| diff(Some(c), at(0, -1), 1.0))?;
+    let coord = Coord {
+        exemplar: e,
+        x: c.x as f32,
+        y: c.y as f32,
+    };
+    let oe = synth::exemplar_orientation(style, level, coord)?;
+    let det = jx.cross(jy);
+    if det.abs() < 1e-9 {
+        return None;
+    }
+    // Solve [jx jy] w = ω^e.
+    let (ex, ey) = (oe[0] as f64, oe[1] as f64);
+    let wx = (ex * jy.y - ey * jy.x) / det;
+    let wy = (jx.x * ey - jx.y * ex) / det;
+    let l = wx.hypot(wy);
+    (l > 0.0).then(|| [(wx / l) as f32, (wy / l) as f32])
+}
+
+/// Pixels (at the start level) by which the seam regions, where the ANN
+/// search runs, extend beyond the overlaps of matched segments.
+pub const SEAM_MARGIN: isize = 3;
+
+/// A coordinate field from several warped exemplar segments: owners,
+/// orientation and seam mask.
+fn compose(
+    style: &BrushStyle,
+    level: usize,
+    fields: &[(u32, Grid<Option<Point>>)],
+    owner: &Grid<Option<usize>>,
+) -> Field {
+    let (w, h) = (owner.width(), owner.height());
+    let mut coords = Grid::new(w, h, None);
+    let mut orient = Grid::new(w, h, [0.0f32; 2]);
+    let mut seam = Grid::new(w, h, false);
+    for y in 0..h {
+        for x in 0..w {
+            let Some(k) = owner.get(x, y) else { continue };
+            let Some((e, g)) = fields.get(k) else {
+                continue;
+            };
+            if let Some(c) = g.get(x, y) {
+                coords.set(
+                    x,
+                    y,
+                    Some(Coord {
+                        exemplar: *e,
+                        x: c.x as f32,
+                        y: c.y as f32,
+                    }),
+                );
+                if let Some(o) = orient_of(style, level, *e, g, x, y) {
+                    orient.set(x, y, o);
+                }
+            }
+            let covering = fields.iter().filter(|(_, g)| g.get(x, y).is_some()).count();
+            if covering > 1 {
+                for dy in -SEAM_MARGIN..=SEAM_MARGIN {
+                    for dx in -SEAM_MARGIN..=SEAM_MARGIN {
+                        let (nx, ny) = (x as isize + dx, y as isize + dy);
+                        if nx >= 0 && ny >= 0 && (nx as usize) < w && (ny as usize) < h {
+                            seam.set(nx as usize, ny as usize, true);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    fill_orientation(&mut orient, &coords);
+    Field {
+        level,
+        coords,
+        orient,
+        seam,
+    }
+}
+
+/// Pixels on the ornament whose orientation could not be estimated take
+/// a neighbour's (a few sweeps).
+fn fill_orientation(orient: &mut Grid<[f32; 2]>, coords: &Grid<Option<Coord>>) {
+    let (w, h) = (orient.width(), orient.height());
+    for _ in 0..4 {
+        let snapshot = orient.clone();
+        let mut missing = false;
+        for y in 0..h {
+            for x in 0..w {
+                if coords.get(x, y).is_none() || snapshot.get(x, y) != [0.0, 0.0] {
+                    continue;
+                }
+                missing = true;
+                let mut acc = [0.0f32; 2];
+                for (dx, dy) in [(1isize, 0isize), (-1, 0), (0, 1), (0, -1)] {
+                    let o = snapshot.get_or(x as isize + dx, y as isize + dy, [0.0, 0.0]);
+                    acc = [acc[0] + o[0], acc[1] + o[1]];
+                }
+                let l = acc[0].hypot(acc[1]);
+                if l > 0.0 {
+                    orient.set(x, y, [acc[0] / l, acc[1] / l]);
+                }
+            }
+        }
+        if !missing {
+            break;
+        }
+    }
+}
+
+/// Paper-ness (0 ink … 1 paper) of a warped segment at a pixel, for the
+/// seam energy.
+fn paper(style: &BrushStyle, level: usize, e: u32, c: Option<Point>) -> Option<f32> {
+    let c = c?;
+    let lv = style.exemplars.get(e as usize)?.levels.get(level)?;
+    Some((0.5 + lv.ink.ink.sample(c.x, c.y)).clamp(0.0, 1.0))
+}
+
+/// Which segment each pixel takes its coordinate from: the first covering
+/// one, then the graph-cut seam between each consecutive pair (§5.3).
+fn seams(
+    style: &BrushStyle,
+    level: usize,
+    fields: &[(u32, Grid<Option<Point>>)],
+    params: &SeamParams,
+) -> Result<Grid<Option<usize>>> {
+    let (w, h) = match fields.first() {
+        Some((_, g)) => (g.width(), g.height()),
+        None => return Err(Error::degenerate("brush", "no matched segments")),
+    };
+    let mut owner = Grid::from_fn(w, h, |x, y| {
+        fields.iter().position(|(_, g)| g.get(x, y).is_some())
+    });
+    for k in 0..fields.len().saturating_sub(1) {
+        let (ea, ga) = (&fields[k].0, &fields[k].1);
+        let (eb, gb) = (&fields[k + 1].0, &fields[k + 1].1);
+        let (mut x0, mut y0, mut x1, mut y1) = (usize::MAX, usize::MAX, 0, 0);
+        for y in 0..h {
+            for x in 0..w {
+                if ga.get(x, y).is_some() && gb.get(x, y).is_some() {
+                    (x0, y0, x1, y1) = (x0.min(x), y0.min(y), x1.max(x), y1.max(y));
+                }
+            }
+        }
+        if x0 > x1 {
+            continue;
+        }
+        let (x0, y0) = (x0.saturating_sub(2), y0.saturating_sub(2));
+        let (x1, y1) = ((x1 + 2).min(w - 1), (y1 + 2).min(h - 1));
+        let (cw, ch) = (x1 - x0 + 1, y1 - y0 + 1);
+        let cover = Grid::from_fn(cw, ch, |x, y| {
+            match (
+                ga.get(x + x0, y + y0).is_some(),
+                gb.get(x + x0, y + y0).is_some(),
+            ) {
+                (true, true) => Cover::Both,
+                (true, false) => Cover::A,
+                (false, true) => Cover::B,
+                (false, false) => Cover::None,
+            }
+        });
+        let a = Grid::from_fn(cw, ch, |x, y| {
+            paper(style, level, *ea, ga.get(x + x0, y + y0)).unwrap_or(1.0)
+        });
+        let b = Grid::from_fn(cw, ch, |x, y| {
+            paper(style, level, *eb, gb.get(x + x0, y + y0)).unwrap_or(1.0)
+        });
+        let s = seam(&a, &b, &cover, params)?;
+        for y in 0..ch {
+            for x in 0..cw {
+                let (gx, gy) = (x + x0, y + y0);
+                match s.labels.get(x, y) {
+                    Label::A if owner.get(gx, gy) == Some(k + 1) => owner.set(gx, gy, Some(k)),
+                    Label::B if cover.get(x, y) == Cover::Both => owner.set(gx, gy, Some(k + 1)),
+                    _ => {}
+                }
+            }
+        }
+    }
+    Ok(owner)
+}
+
+/// Whether the spine starts on an earlier one (within half its width).
+pub fn starts_on(q: &QuerySpine, earlier: &[QuerySpine]) -> bool {
+    let Some(start) = q.samples.first().map(|s| s.pos) else {
+        return false;
+    };
+    earlier.iter().any(|e| {
+        e.samples
+            .iter()
+            .any(|s| s.pos.distance(start) <= 0.5 * e.width.max(q.width))
+    })
+}
+
+/// Marks a branching spine's start as a middle: its end distances from the
+/// start are pushed beyond any end zone.
+pub fn as_branch(q: &mut QuerySpine) {
+    let far = 1e3 * q.width;
+    for s in &mut q.samples {
+        s.dist_start += far;
+    }
+}
+
+/// Synthesizes one query spine (see the module docs).
+pub fn brush_query(style: &BrushStyle, q: &QuerySpine, opts: &BrushOptions) -> Result<QueryResult> {
+    run_query(style, q, opts, false)
+}
+
+/// The coarsest-level field after matching, ARAP and seams, before any
+/// correction (§5.4.1).
+pub fn coarse_init(style: &BrushStyle, q: &QuerySpine, opts: &BrushOptions) -> Result<Field> {
+    Ok(run_query(style, q, opts, true)?.field)
+}
+
+fn run_query(
+    style: &BrushStyle,
+    q: &QuerySpine,
+    opts: &BrushOptions,
+    stop_at_init: bool,
+) -> Result<QueryResult> {
+    let levels = style.exemplars.first().map(|e| e.levels.len()).unwrap_or(0);
+    if levels == 0 || q.samples.len() < 2 {
+        return Err(Error::degenerate("brush", "nothing to synthesize"));
+    }
+    let factor = 1usize << (levels - 1);
+    let ew = exemplar_width(style)?;
+    let canvas = canvas_for(q, ew, factor)?;
+    let scale = 1.0 / canvas.px_per_unit;
+    if opts.art_brush {
+        return art_brush(style, q, canvas, levels);
+    }
+    let h = q.spacing * canvas.px_per_unit;
+    // Samples closer than a quarter exemplar pixel: a stroke far wider
+    // than it is long, or so short it was sampled below its width's pace.
+    if !(h.is_finite() && h >= 0.25) {
+        return Err(Error::degenerate(
+            format!("query {}", q.query_id),
+            format!(
+                "too short for its stroke width ({:.3} long, {:.3} wide)",
+                q.length, q.width
+            ),
+        ));
+    }
+    let mut ribs = Vec::with_capacity(style.exemplars.len());
+    for e in 0..style.exemplars.len() {
+        ribs.push(resample_ribs(style, e, h).ok_or_else(|| {
+            Error::degenerate(
+                format!("style {}", style.name),
+                format!("exemplar {e} has no ribs"),
+            )
+        })?);
+    }
+    let feats: Vec<SpineFeatures> = ribs
+        .iter()
+        .map(|r| exemplar_features(r, scale, ew))
+        .collect();
+    let mopts = MatchOptions {
+        seed: opts.seed,
+        ..opts.matching.clone()
+    };
+    let qf = SpineFeatures::from_query(q);
+    // The beam search can lose every complete state on short or unusual
+    // queries; the exhaustive candidate set then decides.
+    let m = match match_query(&qf, &feats, &mopts) {
+        Ok(m) => m,
+        Err(_) => match_query(
+            &qf,
+            &feats,
+            &MatchOptions {
+                candidates: usize::MAX,
+                beam: usize::MAX,
+                ..mopts
+            },
+        )?,
+    };
+    let start = opts
+        .start_level
+        .unwrap_or_else(|| start_level(style, ew))
+        .min(levels - 1);
+    let div = 1usize << (levels - 1 - start);
+    let coarse = canvas.to_pixel(1.0 / div as f64);
+    let (cw, ch) = (canvas.width / div, canvas.height / div);
+    let mut fields = Vec::with_capacity(m.segments.len());
+    let mut segments = Vec::with_capacity(m.segments.len());
+    for seg in &m.segments {
+        let r = ribs
+            .get(seg.exemplar)
+            .ok_or_else(|| Error::degenerate("brush", "matched exemplar out of range"))?;
+        let s0 = style.exemplars[seg.exemplar].levels[start].scale;
+        let er = seg.exemplar_samples.clone();
+        let sc = |v: &[Point]| {
+            v.iter()
+                .map(|p| (p.to_vec2() * s0).to_point())
+                .collect::<Vec<_>>()
+        };
+        let (Some(sp), Some(le), Some(ri)) = (
+            r.spine.get(er.clone()),
+            r.left.get(er.clone()),
+            r.right.get(er),
+        ) else {
+            return Err(Error::degenerate("brush", "matched samples out of range"));
+        };
+        let mesh = RibMesh::from_ribs(&sc(sp), &sc(le), &sc(ri), 2)?;
+        let arap = Arap::new(&mesh, &mesh.spine)?;
+        let pins: Vec<Point> = q
+            .samples
+            .get(seg.query.clone())
+            .unwrap_or(&[])
+            .iter()
+            .map(|s| coarse * s.pos)
+            .collect();
+        let out = arap.solve(&pins)?;
+        let grid = rasterize_coords(&mesh, &out, cw, ch, Affine::IDENTITY)?;
+        fields.push((seg.exemplar as u32, grid));
+        segments.push((seg.exemplar, seg.query.clone()));
+    }
+    let owner = seams(style, start, &fields, &opts.seams)?;
+    let init = compose(style, start, &fields, &owner);
+    if stop_at_init {
+        return Ok(QueryResult {
+            spine: q.clone(),
+            canvas,
+            energy: synth::energy(style, &init),
+            field: init,
+            segments,
+            levels: Vec::new(),
+        });
+    }
+    let sopts = SynthOptions {
+        seed: opts.seed,
+        ..opts.synth.clone()
+    };
+    let levels = synth::synthesize_levels(style, init, &sopts);
+    let field = levels
+        .last()
+        .cloned()
+        .ok_or_else(|| Error::degenerate("brush", "synthesis produced no level"))?;
+    let energy = synth::energy(style, &field);
+    Ok(QueryResult {
+        spine: q.clone(),
+        canvas,
+        field,
+        energy,
+        segments,
+        levels,
+    })
+}
+
+/// The art-brush baseline at the finest level: the first exemplar's whole
+/// rib mesh stretched along the query (no matching, seams or synthesis).
+fn art_brush(
+    style: &BrushStyle,
+    q: &QuerySpine,
+    canvas: Canvas,
+    levels: usize,
+) -> Result<QueryResult> {
+    let finest = levels - 1;
+    let ex = style
+        .exemplars
+        .first()
+        .ok_or_else(|| Error::degenerate("brush", "the style has no exemplars"))?;
+    let p = |v: &[[f64; 2]]| v.iter().map(|a| Point::new(a[0], a[1])).collect::<Vec<_>>();
+    let r = ex.ribs_at(finest);
+    let mesh = RibMesh::from_ribs(&p(&r.spine), &p(&r.left), &p(&r.right), 2)?;
+    let pts: Vec<Point> = q.samples.iter().map(|s| s.pos).collect();
+    let grid = art_brush_coords(
+        &mesh,
+        &pts,
+        q.width,
+        canvas.width,
+        canvas.height,
+        canvas.to_pixel(1.0),
+    )?;
+    let fields = vec![(0u32, grid)];
+    let owner = Grid::from_fn(canvas.width, canvas.height, |x, y| {
+        fields[0].1.get(x, y).map(|_| 0)
+    });
+    let field = compose(style, finest, &fields, &owner);
+    let energy = synth::energy(style, &field);
+    Ok(QueryResult {
+        spine: q.clone(),
+        canvas,
+        field,
+        energy,
+        segments: Vec::new(),
+        levels: Vec::new(),
+    })
+}

@@ -1,0 +1,480 @@
+//! Hierarchical synthesis of exemplar coordinates (decobrush.txt §5.4,
+//! after Lefebvre & Hoppe 2005): the field μ = (exemplar, x, y) per canvas
+//! pixel is corrected with oriented 5×5 neighbourhoods and upsampled by
+//! coordinate inheritance, coarse to fine.
+//!
+//! * **Correction** (§5.4.2). A pixel's query neighbourhood is read from the
+//!   *appearance* of the current field (each pixel shows the exemplar's ink
+//!   SDF at its μ), on the rotated lattice of
+//!   [`crate::synth::neighbourhood`] with its up axis along the query
+//!   orientation ω^q. Candidates are the pixel's own μ and the eight
+//!   coherent ones: neighbour n's coordinate continued to p,
+//!   `μ(n) + J_e^T J_q (p − n)`. The nearest by L² wins; near-equal ones
+//!   (within a relative tie tolerance) are chosen by a hash of (seed,
+//!   level, pass, pixel). In seam regions the style's k-d tree also gives
+//!   an approximate nearest neighbour over all exemplars, taken when the
+//!   best coherent distance is 5× or more its distance (the paper's rule).
+//! * **Sub-passes.** Pixels are corrected on a 2×2 lattice, four sub-passes
+//!   per iteration; each sub-pass reads only the field left by the previous
+//!   one and writes only its own lattice pixels, so the parallel loop gives
+//!   the same field at any thread count.
+//! * **Upsampling** (§5.4.3). Child `p + Δ` (Δ = (±½, ±½) fine px) of a
+//!   parent p inherits `2 μ(p) + J_e^T J_q Δ`, where `J_q`, `J_e` are the
+//!   reflection matrices `[[ω_x, ω_y], [ω_y, −ω_x]]` of the query and
+//!   exemplar orientations: `J_e^T J_q` is the rotation taking the query's
+//!   stroke frame onto the exemplar's.
+
+use crate::pattern::rng;
+use crate::raster::Grid;
+use crate::style::brush::{BrushStyle, ExemplarLevel};
+use crate::synth::neighbourhood::{Neighbourhood, SIZE};
+use rayon::prelude::*;
+
+/// One exemplar coordinate: exemplar index and a pixel-space position in
+/// that exemplar's pyramid level (pixel centres at half-integers).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Coord {
+    /// Index of the exemplar in its style.
+    pub exemplar: u32,
+    /// Column, px of the level.
+    pub x: f32,
+    /// Row, px of the level.
+    pub y: f32,
+}
+
+/// The synthesis state at one pyramid level, on the canvas of one query.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Field {
+    /// Level index (0 = coarsest).
+    pub level: usize,
+    /// μ per canvas pixel; `None` off the ornament.
+    pub coords: Grid<Option<Coord>>,
+    /// Query stroking orientation ω^q per pixel (unit, pixel axes, y down).
+    pub orient: Grid<[f32; 2]>,
+    /// Seam regions (overlaps of matched segments), where the ANN search
+    /// runs.
+    pub seam: Grid<bool>,
+}
+
+/// Synthesis parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SynthOptions {
+    /// Correction iterations per level (each is four sub-passes; default 2;
+    /// 0 gives the graph cut upsampled without correction).
+    pub iterations: usize,
+    /// Seed of the choice among near-equal candidates.
+    pub seed: u64,
+    /// Relative L² difference under which candidates count as near-equal
+    /// (default 0.02).
+    pub tie: f32,
+    /// The coherent candidate is kept unless its distance is this many
+    /// times the ANN candidate's (default 5, decobrush.txt §5.4.2).
+    pub ann_ratio: f32,
+}
+
+impl Default for SynthOptions {
+    fn default() -> Self {
+        SynthOptions {
+            iterations: 2,
+            seed: 0,
+            tie: 0.02,
+            ann_ratio: 5.0,
+        }
+    }
+}
+
+/// SDF value shown by pixels off the ornament (paper, px).
+const PAPER: f32 = 8.0;
+
+/// Exemplar level `level` of exemplar `e`.
+fn level_of(style: &BrushStyle, e: u32, level: usize) -> Option<&ExemplarLevel> {
+    style.exemplars.get(e as usize)?.levels.get(level)
+}
+
+/// The exemplar pixel holding a coordinate, if inside its stroke region.
+fn region_pixel(lv: &ExemplarLevel, c: Coord) -> Option<(usize, usize)> {
+    if !(c.x >= 0.0 && c.y >= 0.0) {
+        return None;
+    }
+    let (x, y) = (c.x as usize, c.y as usize);
+    if x < lv.width() && y < lv.height() && lv.orientation.mask.get(x, y) {
+        Some((x, y))
+    } else {
+        None
+    }
+}
+
+/// The exemplar orientation ω^e at a coordinate (`None` outside the stroke
+/// region).
+pub fn exemplar_orientation(style: &BrushStyle, level: usize, c: Coord) -> Option<[f32; 2]> {
+    let lv = level_of(style, c.exemplar, level)?;
+    let (x, y) = region_pixel(lv, c)?;
+    let d = lv.orientation.dir.get(x, y);
+    (d != [0.0, 0.0]).then_some(d)
+}
+
+/// The exemplar neighbourhood at a coordinate, oriented along ω^e there.
+pub fn exemplar_neighbourhood(style: &BrushStyle, level: usize, c: Coord) -> Option<Neighbourhood> {
+    let lv = level_of(style, c.exemplar, level)?;
+    let (x, y) = region_pixel(lv, c)?;
+    let up = lv.orientation.dir.get(x, y);
+    Some(
+        style
+            .sampler
+            .sample(&lv.ink.ink, [c.x as f64, c.y as f64], up),
+    )
+}
+
+/// `J_e^T J_q d`: a canvas displacement `d` (px) carried into exemplar
+/// axes, for query orientation `q` and exemplar orientation `e`.
+#[inline]
+pub fn carry(q: [f32; 2], e: [f32; 2], d: [f32; 2]) -> [f32; 2] {
+    let along = q[0] * d[0] + q[1] * d[1];
+    let across = -q[1] * d[0] + q[0] * d[1];
+    [along * e[0] - across * e[1], along * e[1] + across * e[0]]
+}
+
+/// The appearance of a field: per pixel, the exemplar's all-ink SDF at μ
+/// (px), [`PAPER`] off the ornament.
+pub fn appearance(style: &BrushStyle, field: &Field) -> Grid<f32> {
+    let (w, h) = (field.coords.width(), field.coords.height());
+    let rows: Vec<Vec<f32>> = (0..h)
+        .into_par_iter()
+        .map(|y| {
+            (0..w)
+                .map(|x| pixel_look(style, field.level, field.coords.get(x, y)))
+                .collect()
+        })
+        .collect();
+    Grid::from_vec(w, h, rows.concat()).unwrap_or_else(|| Grid::new(w, h, PAPER))
+}
+
+fn pixel_look(style: &BrushStyle, level: usize, c: Option<Coord>) -> f32 {
+    c.and_then(|c| {
+        let lv = level_of(style, c.exemplar, level)?;
+        Some(lv.ink.ink.sample(c.x as f64, c.y as f64))
+    })
+    .unwrap_or(PAPER)
+}
+
+fn dist2(a: &Neighbourhood, b: &Neighbourhood) -> f32 {
+    (0..SIZE).map(|k| (a[k] - b[k]) * (a[k] - b[k])).sum()
+}
+
+/// The query neighbourhood of canvas pixel `(x, y)` in appearance `look`.
+fn query_neighbourhood(
+    style: &BrushStyle,
+    look: &Grid<f32>,
+    field: &Field,
+    x: usize,
+    y: usize,
+) -> Neighbourhood {
+    style.sampler.sample(
+        look,
+        [x as f64 + 0.5, y as f64 + 0.5],
+        field.orient.get(x, y),
+    )
+}
+
+/// The synthesis energy: mean squared L² distance between each covered
+/// pixel's query neighbourhood and the exemplar neighbourhood at its μ
+/// (pixels whose μ left the stroke region count as the largest distance).
+pub fn energy(style: &BrushStyle, field: &Field) -> f64 {
+    let look = appearance(style, field);
+    let (w, h) = (field.coords.width(), field.coords.height());
+    let rows: Vec<(f64, usize)> = (0..h)
+        .into_par_iter()
+        .map(|y| {
+            let mut acc = (0.0, 0);
+            for x in 0..w {
+                if let Some(c) = field.coords.get(x, y) {
+                    let q = query_neighbourhood(style, &look, field, x, y);
+                    let d = exemplar_neighbourhood(style, field.level, c)
+                        .map(|e| dist2(&q, &e))
+                        .unwrap_or(4.0 * SIZE as f32);
+                    acc.0 += d as f64;
+                    acc.1 += 1;
+                }
+            }
+            acc
+        })
+        .collect();
+    let (s, n) = rows
+        .into_iter()
+        .fold((0.0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+    if n == 0 {
+        0.0
+    } else {
+        s / n as f64
+    }
+}
+
+/// The corrected coordinate of one pixel (see the module docs).
+fn correct_pixel(
+    style: &BrushStyle,
+    field: &Field,
+    look: &Grid<f32>,
+    opts: &SynthOptions,
+    pass: u64,
+    x: usize,
+    y: usize,
+) -> Option<Coord> {
+    let cur = field.coords.get(x, y)?;
+    let q = query_neighbourhood(style, look, field, x, y);
+    let l = field.level;
+    let mut cands: Vec<(f32, Coord)> = Vec::with_capacity(10);
+    if let Some(n) = exemplar_neighbourhood(style, l, cur) {
+        cands.push((dist2(&q, &n), cur));
+    }
+    let (w, h) = (
+        field.coords.width() as isize,
+        field.coords.height() as isize,
+    );
+    for dy in -1isize..=1 {
+        for dx in -1isize..=1 {
+            let (nx, ny) = (x as isize + dx, y as isize + dy);
+            if (dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= w || ny >= h {
+                continue;
+            }
+            let (nx, ny) = (nx as usize, ny as usize);
+            let Some(cn) = field.coords.get(nx, ny) else {
+                continue;
+            };
+            let Some(oe) = exemplar_orientation(style, l, cn) else {
+                continue;
+            };
+            let d = carry(field.orient.get(nx, ny), oe, [-dx as f32, -dy as f32]);
+            let c = Coord {
+                exemplar: cn.exemplar,
+                x: cn.x + d[0],
+                y: cn.y + d[1],
+            };
+            if cands.iter().any(|(_, o)| *o == c) {
+                continue;
+            }
+            if let Some(n) = exemplar_neighbourhood(style, l, c) {
+                cands.push((dist2(&q, &n), c));
+            }
+        }
+    }
+    let best = cands.iter().map(|c| c.0).fold(f32::INFINITY, f32::min);
+    let near: Vec<Coord> = cands
+        .iter()
+        .filter(|c| c.0 <= best * (1.0 + opts.tie))
+        .map(|c| c.1)
+        .collect();
+    // An exact match keeps its coordinate (an exemplar copy is a fixed
+    // point); otherwise near-equal candidates are chosen by the seed.
+    let exact = cands.first().is_some_and(|c| c.1 == cur && c.0 == 0.0);
+    let mut pick = match near.len() {
+        _ if exact => cur,
+        0 => cur,
+        1 => near[0],
+        n => near[rng::index(&[opts.seed, l as u64, pass, x as u64, y as u64], n)],
+    };
+    if field.seam.get(x, y) {
+        if let Some(index) = style.indexes.get(l) {
+            if let Some((r, _)) = index.approx_nearest(&q) {
+                let c = Coord {
+                    exemplar: r.exemplar,
+                    x: r.x as f32 + 0.5,
+                    y: r.y as f32 + 0.5,
+                };
+                if let Some(n) = exemplar_neighbourhood(style, l, c) {
+                    let da = dist2(&q, &n);
+                    if !best.is_finite() || best > opts.ann_ratio * da {
+                        pick = c;
+                    }
+                }
+            }
+        }
+    }
+    Some(pick)
+}
+
+/// Runs `opts.iterations` correction iterations on `field` (§5.4.2).
+pub fn correct(style: &BrushStyle, field: &mut Field, opts: &SynthOptions) {
+    correct_in(style, field, opts, None);
+}
+
+/// [`correct`] restricted to the pixels where `only` is true (all when
+/// `None`); the others are locked (§5.5).
+pub fn correct_in(
+    style: &BrushStyle,
+    field: &mut Field,
+    opts: &SynthOptions,
+    only: Option<&Grid<bool>>,
+) {
+    let (w, h) = (field.coords.width(), field.coords.height());
+    let mut look = appearance(style, field);
+    for it in 0..opts.iterations {
+        for (k, (ox, oy)) in [(0usize, 0usize), (1, 1), (1, 0), (0, 1)]
+            .into_iter()
+            .enumerate()
+        {
+            let pass = (it * 4 + k) as u64;
+            let snapshot: &Field = field;
+            let updates: Vec<(usize, usize, Option<Coord>)> = (oy..h)
+                .step_by(2)
+                .collect::<Vec<_>>()
+                .into_par_iter()
+                .flat_map_iter(|y| {
+                    let look = &look;
+                    (ox..w).step_by(2).filter_map(move |x| {
+                        let cur = snapshot.coords.get(x, y);
+                        cur?;
+                        if only.is_some_and(|m| !m.get(x, y)) {
+                            return None;
+                        }
+                        let new = correct_pixel(style, snapshot, look, opts, pass, x, y);
+                        (new != cur).then_some((x, y, new))
+                    })
+                })
+                .collect();
+            for (x, y, c) in updates {
+                field.coords.set(x, y, c);
+                look.set(x, y, pixel_look(style, field.level, c));
+            }
+        }
+    }
+}
+
+/// Upsamples `field` to the next finer level (§5.4.3): a canvas twice as
+/// large, each child inheriting its parent's coordinate doubled and offset
+/// by the rotated half-pixel displacement; orientation and seam mask are
+/// inherited as they are.
+pub fn upsample(style: &BrushStyle, field: &Field) -> Field {
+    let (w, h) = (field.coords.width() * 2, field.coords.height() * 2);
+    let l = field.level;
+    let coords = Grid::from_fn(w, h, |x, y| {
+        let (px, py) = (x / 2, y / 2);
+        let c = field.coords.get(px, py)?;
+        let delta = [
+            if x % 2 == 0 { -0.5 } else { 0.5 },
+            if y % 2 == 0 { -0.5 } else { 0.5 },
+        ];
+        let oe = exemplar_orientation(style, l, c).unwrap_or(field.orient.get(px, py));
+        let d = carry(field.orient.get(px, py), oe, delta);
+        Some(Coord {
+            exemplar: c.exemplar,
+            x: 2.0 * c.x + d[0],
+            y: 2.0 * c.y + d[1],
+        })
+    });
+    Field {
+        level: l + 1,
+        coords,
+        orient: Grid::from_fn(w, h, |x, y| field.orient.get(x / 2, y / 2)),
+        seam: Grid::from_fn(w, h, |x, y| field.seam.get(x / 2, y / 2)),
+    }
+}
+
+/// The whole §5.4 pipeline from an initialized coarsest field: correct,
+/// upsample, correct, … up to the finest level of the style.
+pub fn synthesize(style: &BrushStyle, init: Field, opts: &SynthOptions) -> Field {
+    let mut levels = synthesize_levels(style, init, opts);
+    levels.pop().unwrap_or_else(|| Field {
+        level: 0,
+        coords: Grid::new(0, 0, None),
+        orient: Grid::new(0, 0, [0.0; 2]),
+        seam: Grid::new(0, 0, false),
+    })
+}
+
+/// [`synthesize`], keeping the corrected field of every level visited,
+/// coarse to fine.
+pub fn synthesize_levels(style: &BrushStyle, init: Field, opts: &SynthOptions) -> Vec<Field> {
+    let levels = style.exemplars.first().map(|e| e.levels.len()).unwrap_or(1);
+    let mut out = Vec::new();
+    let mut field = init;
+    loop {
+        correct(style, &mut field, opts);
+        if field.level + 1 >= levels {
+            out.push(field);
+            return out;
+        }
+        let next = upsample(style, &field);
+        out.push(field);
+        field = next;
+    }
+}
+
+/// User-guided refinement (decobrush.txt §5.5). `levels` are a synthesis's
+/// fields coarse to fine; `target` the finest-level appearance the user
+/// asks for (ink SDF, px: the synthesized one with added strokes inked and
+/// erased ones cleared) and `mask` the dilated refined pixels. At the
+/// coarsest level the masked pixels take the nearest exemplar
+/// neighbourhood of the target (no coherence), then every level is
+/// upsampled and corrected inside the mask only; outside it the original
+/// coordinates stay locked.
+pub fn refine(
+    style: &BrushStyle,
+    levels: &[Field],
+    target: &Grid<f32>,
+    mask: &Grid<bool>,
+    opts: &SynthOptions,
+) -> Option<Field> {
+    let first = levels.first()?;
+    let n = levels.len();
+    let down = |k: usize| 1usize << (n - 1 - k);
+    let mask_at = |k: usize, f: &Field| {
+        let d = down(k);
+        Grid::from_fn(f.coords.width(), f.coords.height(), |x, y| {
+            (0..d).any(|j| {
+                (0..d).any(|i| mask.get_or((x * d + i) as isize, (y * d + j) as isize, false))
+            })
+        })
+    };
+    let mut field = first.clone();
+    let m0 = mask_at(0, &field);
+    let d0 = down(0);
+    let mut look = appearance(style, &field);
+    for y in 0..look.height() {
+        for x in 0..look.width() {
+            if m0.get(x, y) {
+                let t = target.get_or(
+                    (x * d0 + d0 / 2) as isize,
+                    (y * d0 + d0 / 2) as isize,
+                    PAPER,
+                );
+                look.set(x, y, t / d0 as f32);
+            }
+        }
+    }
+    let index = style.indexes.get(field.level)?;
+    for y in 0..look.height() {
+        for x in 0..look.width() {
+            if !m0.get(x, y) {
+                continue;
+            }
+            let q = query_neighbourhood(style, &look, &field, x, y);
+            if let Some((r, _)) = index.nearest(&q) {
+                field.coords.set(
+                    x,
+                    y,
+                    Some(Coord {
+                        exemplar: r.exemplar,
+                        x: r.x as f32 + 0.5,
+                        y: r.y as f32 + 0.5,
+                    }),
+                );
+            }
+        }
+    }
+    correct_in(style, &mut field, opts, Some(&m0));
+    for (k, original) in levels.iter().enumerate().skip(1) {
+        let mut next = upsample(style, &field);
+        let mk = mask_at(k, original);
+        for y in 0..next.coords.height() {
+            for x in 0..next.coords.width() {
+                if !mk.get(x, y) {
+                    next.coords
+                        .set(x, y, original.coords.get_or(x as isize, y as isize, None));
+                }
+            }
+        }
+        correct_in(style, &mut next, opts, Some(&mk));
+        field = next;
+    }
+    Some(field)
+}
