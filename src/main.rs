@@ -333,6 +333,11 @@ fn run_pattern(args: PatternArgs, quiet: bool, verbose: bool) -> Result<(), Fail
     };
     let job = |sketch: &Path| -> Result<String, Error> {
         let sk = flourish::sketch::load(sketch)?;
+        if !quiet {
+            for w in &sk.warnings {
+                eprintln!("flourish: warning: {}: {w}", sketch.display());
+            }
+        }
         if verbose {
             for note in &sk.notes {
                 eprintln!("flourish: {}: {note}", sketch.display());
@@ -373,6 +378,11 @@ fn run_fill(args: FillArgs, quiet: bool, verbose: bool) -> Result<(), Failure> {
     };
     let job = |sketch: &Path| -> Result<String, Error> {
         let sk = flourish::sketch::load(sketch)?;
+        if !quiet {
+            for w in &sk.warnings {
+                eprintln!("flourish: warning: {}: {w}", sketch.display());
+            }
+        }
         let out = fill::fill_sketch(&opts, &sk)?;
         if verbose {
             for note in sk.notes.iter().chain(&out.notes) {
@@ -429,6 +439,11 @@ fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
         };
         let job = |sketch: &Path| -> Result<String, Error> {
             let sk = flourish::sketch::load(sketch)?;
+            if !quiet {
+                for w in &sk.warnings {
+                    eprintln!("flourish: warning: {}: {w}", sketch.display());
+                }
+            }
             if verbose {
                 for note in &sk.notes {
                     eprintln!("flourish: {}: {note}", sketch.display());

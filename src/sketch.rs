@@ -71,6 +71,9 @@ pub struct Sketch {
     pub queries: Vec<Query>,
     /// Things ignored, one line each, for `--verbose`.
     pub notes: Vec<String>,
+    /// Shapes the designer drew that cannot be used (no length, zero
+    /// stroke width), one line each, printed unless `--quiet`.
+    pub warnings: Vec<String>,
 }
 
 /// Reads and parses a sketch SVG file.
@@ -100,6 +103,7 @@ pub fn parse(path: &Path, data: &[u8]) -> Result<Sketch> {
         view_box,
         queries: Vec::new(),
         notes: Vec::new(),
+        warnings: Vec::new(),
     };
     walk(tree.root(), to_user, &pre.styles, &mut sketch);
     Ok(sketch)
@@ -314,8 +318,8 @@ fn add_path(p: &usvg::Path, to_user: Affine, styles: &BTreeMap<String, String>, 
     let geom = abs * to_bezpath(p.data(), usvg::Transform::identity());
     if geom.elements().is_empty() || geom.bounding_box().area() == 0.0 && geom.perimeter(0.1) == 0.0
     {
-        sk.notes
-            .push(format!("{label} has no geometry and is ignored"));
+        sk.warnings
+            .push(format!("{label} has no length and is skipped"));
         return;
     }
     let n = sk.queries.len() + 1;
@@ -344,8 +348,8 @@ fn add_path(p: &usvg::Path, to_user: Affine, styles: &BTreeMap<String, String>, 
         let scale = abs.determinant().abs().sqrt();
         let width = stroke.width().get() as f64 * scale;
         if width.is_nan() || width <= 0.0 {
-            sk.notes
-                .push(format!("{label} has a zero stroke width and is ignored"));
+            sk.warnings
+                .push(format!("{label} has a zero stroke width and is skipped"));
             return;
         }
         sk.queries.push(Query {

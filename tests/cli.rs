@@ -1271,3 +1271,40 @@ fn io_errors_name_the_output_not_a_temp_file() {
         stderr(&o)
     );
 }
+
+/// A stroked path with no length is skipped with a warning on stderr (not
+/// only a `--verbose` note); the other paths are still drawn, exit 0.
+#[test]
+fn zero_length_path_is_skipped_with_a_warning() {
+    let dir = tempdir();
+    let sketch = dir.path().join("sketch.svg");
+    std::fs::write(
+        &sketch,
+        r##"<svg xmlns="http://www.w3.org/2000/svg" width="200" height="100">
+  <path d="M10 50 C60 10 140 90 190 50" stroke="#000" stroke-width="12" fill="none"/>
+  <path id="dot" d="M100 80 L100 80" stroke="#000" stroke-width="12" fill="none"/>
+</svg>"##,
+    )
+    .unwrap();
+    let out = dir.path().join("out.svg");
+    let o = flourish(&["pattern", "--style", "hatching", s(&sketch), "-o", s(&out)]);
+    assert_eq!(code(&o), Some(0), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("warning") && err.contains("no length"),
+        "{err}"
+    );
+    assert!(out.exists());
+    // --quiet silences it.
+    let o = flourish(&[
+        "pattern",
+        "--quiet",
+        "--style",
+        "hatching",
+        s(&sketch),
+        "-o",
+        s(&out),
+    ]);
+    assert_eq!(code(&o), Some(0));
+    assert!(stderr(&o).is_empty(), "{}", stderr(&o));
+}

@@ -457,8 +457,8 @@ mod tests {
             .iter()
             .any(|w| w.contains("far") && w.contains("outside")));
         assert_eq!(set.notes.len(), 1, "{:?}", set.notes);
-        // `dot` has no geometry: sketch.rs already drops it with a note.
-        assert!(s.notes.iter().any(|n| n.contains("dot")));
+        // `dot` has no length: sketch.rs already skips it with a warning.
+        assert!(s.warnings.iter().any(|w| w.contains("dot")));
     }
 
     #[test]
