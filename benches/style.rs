@@ -24,7 +24,7 @@ fn copy_without_spines(from: &std::path::Path, to: &std::path::Path) -> std::io:
     for entry in std::fs::read_dir(from)? {
         let p = entry?.path();
         let Some(name) = p.file_name() else { continue };
-        if p.extension().map_or(true, |e| e != "svg") {
+        if p.extension().is_none_or(|e| e != "svg") {
             std::fs::copy(&p, to.join(name))?;
             continue;
         }

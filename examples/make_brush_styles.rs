@@ -285,7 +285,7 @@ impl Centerline {
 fn smooth_polyline(raw: &[Point], closed: bool) -> BezPath {
     let mut pts: Vec<Point> = Vec::with_capacity(raw.len());
     for &p in raw {
-        if pts.last().map_or(true, |q: &Point| (p - *q).hypot() > 0.02) {
+        if pts.last().is_none_or(|q: &Point| (p - *q).hypot() > 0.02) {
             pts.push(p);
         }
     }

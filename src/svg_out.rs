@@ -34,7 +34,7 @@ impl Color {
 
     /// The colour as SVG wants it: `#rgb` when that is exact, else `#rrggbb`.
     pub fn to_hex(self) -> String {
-        let short = |c: u8| c % 17 == 0;
+        let short = |c: u8| c.is_multiple_of(17);
         if short(self.r) && short(self.g) && short(self.b) {
             format!("#{:x}{:x}{:x}", self.r / 17, self.g / 17, self.b / 17)
         } else {
@@ -286,7 +286,7 @@ fn fmt_fixed(q: i64, decimals: u32) -> String {
     }
     if frac != 0 {
         let mut digits = decimals as usize;
-        while frac % 10 == 0 {
+        while frac.is_multiple_of(10) {
             frac /= 10;
             digits -= 1;
         }

@@ -441,7 +441,7 @@ pub fn match_query(
                         let v = prev.cost[pi * slots + r];
                         let key = rng::hash(&[opts.seed, q as u64, pi as u64, r as u64, 0xC0]);
                         let take = v.is_finite()
-                            && best.map_or(true, |(bv, _, bk)| near_better(v, key, bv, bk));
+                            && best.is_none_or(|(bv, _, bk)| near_better(v, key, bv, bk));
                         if take {
                             best = Some((v, r, key));
                         }
@@ -509,7 +509,7 @@ pub fn match_query(
             let slot = ci * slots + r;
             let v = last.cost[slot];
             let key = rng::hash(&[opts.seed, n as u64, slot as u64, 0xE2D]);
-            if v.is_finite() && best.map_or(true, |(_, bv, bk)| near_better(v, key, bv, bk)) {
+            if v.is_finite() && best.is_none_or(|(_, bv, bk)| near_better(v, key, bv, bk)) {
                 best = Some((slot, v, key));
             }
         }

@@ -297,7 +297,7 @@ impl FlowGraph {
             let link = if tree == Tree::Source { e ^ 1 } else { e };
             if bk.tree[q] == tree && self.cap[link] > 0 {
                 if let Some(d) = self.origin(bk, q) {
-                    if best.map_or(true, |(_, bd)| d < bd) {
+                    if best.is_none_or(|(_, bd)| d < bd) {
                         best = Some((link, d));
                     }
                 }

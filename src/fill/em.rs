@@ -262,7 +262,7 @@ pub fn interior_energy(nnf: &Nnf, r: usize, w: usize, h: usize, active: Option<&
         .enumerate()
         .filter(|(k, _)| {
             let (x, y) = nnf.centre(*k);
-            let on = active.map_or(true, |a| a.get(*k).copied().unwrap_or(true));
+            let on = active.is_none_or(|a| a.get(*k).copied().unwrap_or(true));
             on && x >= r && y >= r && x + r < w && y + r < h
         })
         .map(|(_, m)| m.cost as f64)
@@ -397,7 +397,7 @@ fn histogram_weights(phi: &[Grid<f32>], t: &Tile, near: Option<&Grid<f32>>) -> V
         .map(|(l, g)| {
             let (mut ink, mut all) = (0usize, 0usize);
             for (i, &v) in g.data().iter().enumerate() {
-                if near.map_or(true, |d| d.data().get(i).is_some_and(|&e| e == 0.0)) {
+                if near.is_none_or(|d| d.data().get(i).is_some_and(|&e| e == 0.0)) {
                     all += 1;
                     ink += usize::from(v < 0.0);
                 }

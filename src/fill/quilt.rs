@@ -151,8 +151,8 @@ pub fn quilt(
             });
             for y in 0..bh {
                 for x in 0..bw {
-                    let new_side_v = vcut.as_ref().map_or(true, |c| x >= c[y]);
-                    let new_side_h = hcut.as_ref().map_or(true, |c| y >= c[x]);
+                    let new_side_v = vcut.as_ref().is_none_or(|c| x >= c[y]);
+                    let new_side_h = hcut.as_ref().is_none_or(|c| y >= c[x]);
                     if !filled.get(bx + x, by + y) || (new_side_v && new_side_h) {
                         let (cx, cy) = rot(sx, sy, x, y, be);
                         map.set(bx + x, by + y, (cx as u32, cy as u32));

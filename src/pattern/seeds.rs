@@ -265,7 +265,7 @@ fn first_crossing(rings: &[Vec<Point>]) -> Option<Point> {
                 }
                 if let Some(p) = proper_crossing(ea.2, ea.3, eb.2, eb.3) {
                     let key = (a.min(b), a.max(b), p);
-                    if best.map_or(true, |bst| (key.0, key.1) < (bst.0, bst.1)) {
+                    if best.is_none_or(|bst| (key.0, key.1) < (bst.0, bst.1)) {
                         best = Some(key);
                     }
                 }

@@ -173,7 +173,7 @@ fn optimal_polygon(lon: &[usize], n: usize) -> Vec<usize> {
     for k in 0..tries {
         let start = k * n / tries;
         let poly = cover(start);
-        if best.as_ref().map_or(true, |b| poly.len() < b.len()) {
+        if best.as_ref().is_none_or(|b| poly.len() < b.len()) {
             best = Some(poly);
         }
     }

@@ -121,7 +121,7 @@ impl<'de, T: Plain> Deserialize<'de> for Decoded<T> {
                 f.write_str("a byte string of samples")
             }
             fn visit_bytes<E: de::Error>(self, v: &[u8]) -> Result<Decoded<T>, E> {
-                if T::BYTES == 0 || v.len() % T::BYTES != 0 {
+                if T::BYTES == 0 || !v.len().is_multiple_of(T::BYTES) {
                     return Err(E::custom("sample data has a partial sample"));
                 }
                 Ok(Decoded(decode(v)))
