@@ -17,8 +17,9 @@ deps:
 # The main job on the shipped samples: traces and patterns, with previews, into out/.
 demo:
 	$(CARGO) build --release
-	mkdir -p $(OUT)/trace $(OUT)/pattern
-	$(BIN) trace samples/trace/*.png samples/trace/*.svg --out-dir $(OUT)/trace --preview $(OUT)/trace
+	mkdir -p $(OUT)/trace/png $(OUT)/trace/svg $(OUT)/pattern
+	$(BIN) trace samples/trace/*.png --out-dir $(OUT)/trace/png --preview $(OUT)/trace/png
+	$(BIN) trace samples/trace/*.svg --out-dir $(OUT)/trace/svg --preview $(OUT)/trace/svg
 	$(BIN) trace samples/trace/two-colour.svg --layers -o $(OUT)/trace/two-colour-layers.svg --preview $(OUT)/trace/two-colour-layers.png
 	for style in hatching stipple flowers brushmarks; do \
 	  for s in samples/pattern/*.svg; do \
