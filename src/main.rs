@@ -82,6 +82,24 @@ struct StyleCheckArgs {
     strict: bool,
 }
 
+/// Where a command writes, shared by every mode that converts files.
+#[derive(Args)]
+struct Outputs {
+    /// Output SVG (`-` for standard output); one input only.
+    #[arg(short = 'o', long = "output", value_name = "OUT.svg")]
+    output: Option<PathBuf>,
+    /// Output folder for a batch: NAME.svg per input.
+    #[arg(long, value_name = "DIR", conflicts_with = "output")]
+    out_dir: Option<PathBuf>,
+    /// Render the result to a PNG (with --out-dir: a folder for NAME.png).
+    #[arg(long, value_name = "PNG")]
+    preview: Option<PathBuf>,
+    /// Random seed: the same inputs and seed give the same output at any
+    /// thread count (tracing has no randomness and ignores it).
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+}
+
 #[derive(Args)]
 struct FillArgs {
     /// Sketch SVGs: filled shapes get the pattern; open paths inside them comb its direction.
@@ -93,18 +111,8 @@ struct FillArgs {
     /// Folder of named styles (default: the styles shipped with flourish).
     #[arg(long, value_name = "DIR")]
     styles: Option<PathBuf>,
-    /// Output SVG (`-` for standard output); one sketch only.
-    #[arg(short = 'o', long = "output", value_name = "OUT.svg")]
-    output: Option<PathBuf>,
-    /// Output folder for a batch: NAME.svg per sketch.
-    #[arg(long, value_name = "DIR", conflicts_with = "output")]
-    out_dir: Option<PathBuf>,
-    /// Render the result to a PNG (with --out-dir: a folder for NAME.png).
-    #[arg(long, value_name = "PNG")]
-    preview: Option<PathBuf>,
-    /// Random seed: the same seed gives the same output.
-    #[arg(long, default_value_t = 0)]
-    seed: u64,
+    #[command(flatten)]
+    out: Outputs,
     /// An SVG of open stroked paths that comb the pattern's direction in every region.
     #[arg(long, value_name = "D.svg")]
     direction: Option<PathBuf>,
@@ -127,18 +135,8 @@ struct BrushArgs {
     /// Style analysis cache folder.
     #[arg(long, value_name = "DIR")]
     cache: Option<PathBuf>,
-    /// Output SVG (`-` for standard output).
-    #[arg(short = 'o', long = "output", value_name = "OUT.svg")]
-    output: Option<PathBuf>,
-    /// Output folder for several sketches.
-    #[arg(long, value_name = "DIR", conflicts_with = "output")]
-    out_dir: Option<PathBuf>,
-    /// Also render a PNG preview (a folder with --out-dir).
-    #[arg(long, value_name = "PNG")]
-    preview: Option<PathBuf>,
-    /// Seed of the choices among near-equal candidates.
-    #[arg(long, default_value_t = 0)]
-    seed: u64,
+    #[command(flatten)]
+    out: Outputs,
     /// Write N alternatives OUT-1.svg … OUT-N.svg (seeds seed … seed+N−1).
     #[arg(long, default_value_t = 1, value_name = "N")]
     variations: u32,
@@ -164,18 +162,8 @@ struct PatternArgs {
     /// Folder of named styles (default: the styles shipped with flourish).
     #[arg(long, value_name = "DIR")]
     styles: Option<PathBuf>,
-    /// Output SVG (`-` for standard output); one sketch only.
-    #[arg(short = 'o', long = "output", value_name = "OUT.svg")]
-    output: Option<PathBuf>,
-    /// Output folder for a batch: NAME.svg per sketch.
-    #[arg(long, value_name = "DIR", conflicts_with = "output")]
-    out_dir: Option<PathBuf>,
-    /// Render the result to a PNG (with --out-dir: a folder for NAME.png).
-    #[arg(long, value_name = "PNG")]
-    preview: Option<PathBuf>,
-    /// Random seed: the same seed gives the same output.
-    #[arg(long, default_value_t = 0)]
-    seed: u64,
+    #[command(flatten)]
+    out: Outputs,
     /// Amount of variation between repeated elements, 0..1.
     #[arg(long, default_value_t = 0.0, value_name = "0..1")]
     variation: f64,
@@ -186,15 +174,8 @@ struct TraceArgs {
     /// Input files: PNG, JPEG, BMP, GIF, TIFF, WebP or SVG.
     #[arg(required = true, value_name = "IN")]
     inputs: Vec<PathBuf>,
-    /// Output SVG (`-` for standard output); one input only.
-    #[arg(short = 'o', long = "output", value_name = "OUT.svg")]
-    output: Option<PathBuf>,
-    /// Output folder for a batch: NAME.svg per input.
-    #[arg(long, value_name = "DIR", conflicts_with = "output")]
-    out_dir: Option<PathBuf>,
-    /// Render the result to a PNG (with --out-dir: a folder for NAME.png).
-    #[arg(long, value_name = "PNG")]
-    preview: Option<PathBuf>,
+    #[command(flatten)]
+    out: Outputs,
     /// Largest distance of the curves from the outline, in pixels.
     #[arg(long, default_value_t = 0.25, value_name = "PX")]
     tolerance: f64,
@@ -210,9 +191,6 @@ struct TraceArgs {
     /// Trace each fill colour separately and stack the layers.
     #[arg(long)]
     layers: bool,
-    /// Accepted for uniformity with the other modes; tracing has no randomness.
-    #[arg(long, default_value_t = 0)]
-    seed: u64,
 }
 
 #[derive(Args)]
@@ -306,9 +284,9 @@ fn run_trace(args: TraceArgs, quiet: bool) -> Result<(), Failure> {
     };
     run_jobs(
         &args.inputs,
-        args.output.as_deref(),
-        args.out_dir.as_deref(),
-        args.preview.as_deref(),
+        args.out.output.as_deref(),
+        args.out.out_dir.as_deref(),
+        args.out.preview.as_deref(),
         quiet,
         &job,
     )
@@ -327,7 +305,7 @@ fn run_pattern(args: PatternArgs, quiet: bool, verbose: bool) -> Result<(), Fail
             .styles
             .clone()
             .unwrap_or_else(flourish::style::default_styles_dir),
-        seed: args.seed,
+        seed: args.out.seed,
         variation: args.variation,
         ..PatternOptions::default()
     };
@@ -349,9 +327,9 @@ fn run_pattern(args: PatternArgs, quiet: bool, verbose: bool) -> Result<(), Fail
     };
     run_jobs(
         &args.sketches,
-        args.output.as_deref(),
-        args.out_dir.as_deref(),
-        args.preview.as_deref(),
+        args.out.output.as_deref(),
+        args.out.out_dir.as_deref(),
+        args.out.preview.as_deref(),
         quiet,
         &job,
     )
@@ -371,7 +349,7 @@ fn run_fill(args: FillArgs, quiet: bool, verbose: bool) -> Result<(), Failure> {
             .styles
             .clone()
             .unwrap_or_else(flourish::style::default_styles_dir),
-        seed: args.seed,
+        seed: args.out.seed,
         direction: args.direction.clone(),
         resolution: args.resolution,
         ..FillOptions::default()
@@ -393,9 +371,9 @@ fn run_fill(args: FillArgs, quiet: bool, verbose: bool) -> Result<(), Failure> {
     };
     run_jobs(
         &args.sketches,
-        args.output.as_deref(),
-        args.out_dir.as_deref(),
-        args.preview.as_deref(),
+        args.out.output.as_deref(),
+        args.out.out_dir.as_deref(),
+        args.out.preview.as_deref(),
         quiet,
         &job,
     )
@@ -410,7 +388,7 @@ fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
         return Err(Failure::Usage("--variations must be in 1..=100".into()));
     }
     if args.variations > 1
-        && (args.output.is_none() || args.output.as_deref() == Some(Path::new("-")))
+        && (args.out.output.is_none() || args.out.output.as_deref() == Some(Path::new("-")))
     {
         return Err(Failure::Usage(
             "--variations needs -o OUT.svg (a file)".into(),
@@ -428,7 +406,7 @@ fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
     let style = BrushStyle::load(&dir, &analysis)?;
     for k in 0..args.variations {
         let opts = BrushOptions {
-            seed: args.seed.wrapping_add(k as u64),
+            seed: args.out.seed.wrapping_add(k as u64),
             art_brush: args.art_brush,
             refine: args.refine.clone(),
             synth: flourish::brush::synth::SynthOptions {
@@ -485,9 +463,9 @@ fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
                 .unwrap_or_default();
             p.with_file_name(format!("{stem}-{}{ext}", k + 1))
         };
-        let output = args.output.as_deref().map(suffixed);
-        let preview = args.preview.as_deref().map(|p| {
-            if args.out_dir.is_some() {
+        let output = args.out.output.as_deref().map(suffixed);
+        let preview = args.out.preview.as_deref().map(|p| {
+            if args.out.out_dir.is_some() {
                 p.to_path_buf()
             } else {
                 suffixed(p)
@@ -496,7 +474,7 @@ fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
         run_jobs(
             &args.sketches,
             output.as_deref(),
-            args.out_dir.as_deref(),
+            args.out.out_dir.as_deref(),
             preview.as_deref(),
             quiet,
             &job,

@@ -12,26 +12,8 @@
 use crate::brush::arap::{rasterize_coords, RibMesh};
 use crate::error::{Error, Result};
 use crate::raster::Grid;
+use crate::style::uv::tangents;
 use kurbo::{Affine, Point, Vec2};
-
-/// Unit tangents of a polyline at its vertices (mean of the adjacent edge
-/// directions, one-sided at the ends).
-fn tangents(pts: &[Point]) -> Vec<Vec2> {
-    let n = pts.len();
-    (0..n)
-        .map(|i| {
-            let a = pts[i.saturating_sub(1)];
-            let b = pts[(i + 1).min(n - 1)];
-            let d = b - a;
-            let l = d.hypot();
-            if l > 0.0 {
-                d / l
-            } else {
-                Vec2::new(1.0, 0.0)
-            }
-        })
-        .collect()
-}
 
 /// Cumulative arc length at each vertex of a polyline.
 fn arc_lengths(pts: &[Point]) -> Vec<f64> {

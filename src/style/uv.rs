@@ -144,7 +144,7 @@ pub fn resample(poly: &[Point], n: usize) -> Vec<Point> {
 }
 
 /// Unit tangents of a polyline (central differences, one-sided at ends).
-fn tangents(p: &[Point]) -> Vec<Vec2> {
+pub fn tangents(p: &[Point]) -> Vec<Vec2> {
     let n = p.len();
     (0..n)
         .map(|i| {
