@@ -292,6 +292,23 @@ fn run_trace(args: TraceArgs, quiet: bool) -> Result<(), Failure> {
     )
 }
 
+/// Reads a sketch and reports what it skipped: warnings unless `quiet`,
+/// notes under `verbose`.
+fn load_sketch(path: &Path, quiet: bool, verbose: bool) -> Result<flourish::sketch::Sketch, Error> {
+    let sk = flourish::sketch::load(path)?;
+    if !quiet {
+        for w in &sk.warnings {
+            eprintln!("flourish: warning: {}: {w}", path.display());
+        }
+    }
+    if verbose {
+        for note in &sk.notes {
+            eprintln!("flourish: {}: {note}", path.display());
+        }
+    }
+    Ok(sk)
+}
+
 fn run_pattern(args: PatternArgs, quiet: bool, verbose: bool) -> Result<(), Failure> {
     if !(args.variation.is_finite() && (0.0..=1.0).contains(&args.variation)) {
         return Err(Failure::Usage(format!(
@@ -310,17 +327,7 @@ fn run_pattern(args: PatternArgs, quiet: bool, verbose: bool) -> Result<(), Fail
         ..PatternOptions::default()
     };
     let job = |sketch: &Path| -> Result<String, Error> {
-        let sk = flourish::sketch::load(sketch)?;
-        if !quiet {
-            for w in &sk.warnings {
-                eprintln!("flourish: warning: {}: {w}", sketch.display());
-            }
-        }
-        if verbose {
-            for note in &sk.notes {
-                eprintln!("flourish: {}: {note}", sketch.display());
-            }
-        }
+        let sk = load_sketch(sketch, quiet, verbose)?;
         Ok(pattern::synthesize_sketch(&opts, &sk)?
             .to_document()
             .to_svg())
@@ -355,15 +362,10 @@ fn run_fill(args: FillArgs, quiet: bool, verbose: bool) -> Result<(), Failure> {
         ..FillOptions::default()
     };
     let job = |sketch: &Path| -> Result<String, Error> {
-        let sk = flourish::sketch::load(sketch)?;
-        if !quiet {
-            for w in &sk.warnings {
-                eprintln!("flourish: warning: {}: {w}", sketch.display());
-            }
-        }
+        let sk = load_sketch(sketch, quiet, verbose)?;
         let out = fill::fill_sketch(&opts, &sk)?;
         if verbose {
-            for note in sk.notes.iter().chain(&out.notes) {
+            for note in &out.notes {
                 eprintln!("flourish: {}: {note}", sketch.display());
             }
         }
@@ -416,17 +418,7 @@ fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
             ..BrushOptions::default()
         };
         let job = |sketch: &Path| -> Result<String, Error> {
-            let sk = flourish::sketch::load(sketch)?;
-            if !quiet {
-                for w in &sk.warnings {
-                    eprintln!("flourish: warning: {}: {w}", sketch.display());
-                }
-            }
-            if verbose {
-                for note in &sk.notes {
-                    eprintln!("flourish: {}: {note}", sketch.display());
-                }
-            }
+            let sk = load_sketch(sketch, quiet, verbose)?;
             let out = brush_sketch(&style, &sk, &opts)?;
             if !quiet {
                 for w in &out.warnings {

@@ -363,17 +363,10 @@ impl<'a> Problem<'a> {
                 let mut radius = sw.max(sh) as i64 / 2;
                 let mut i = 0u64;
                 while radius >= 1 {
-                    let key = [seed, round, k as u64, i];
-                    let ox = rng::index(
-                        &[key[0], key[1], key[2], key[3], 0],
-                        2 * radius as usize + 1,
-                    ) as i64
-                        - radius;
-                    let oy = rng::index(
-                        &[key[0], key[1], key[2], key[3], 1],
-                        2 * radius as usize + 1,
-                    ) as i64
-                        - radius;
+                    let span = 2 * radius as usize + 1;
+                    let draw =
+                        |axis| rng::index(&[seed, round, k as u64, i, axis], span) as i64 - radius;
+                    let (ox, oy) = (draw(0), draw(1));
                     let (px, py) = self.wrap(best.x as i64 + ox, best.y as i64 + oy);
                     let c = self.distance(buf, qx, qy, px, py, best.cost);
                     if c < best.cost {

@@ -21,55 +21,24 @@ pub trait Plain: Copy {
     fn get(b: &[u8]) -> Self;
 }
 
-impl Plain for f32 {
-    const BYTES: usize = 4;
-    fn put(self, out: &mut Vec<u8>) {
-        out.extend_from_slice(&self.to_le_bytes());
-    }
-    fn get(b: &[u8]) -> Self {
-        f32::from_le_bytes([b[0], b[1], b[2], b[3]])
-    }
+/// `Plain` for a number type as its little-endian bytes.
+macro_rules! plain_le {
+    ($($t:ty),*) => {$(
+        impl Plain for $t {
+            const BYTES: usize = std::mem::size_of::<$t>();
+            fn put(self, out: &mut Vec<u8>) {
+                out.extend_from_slice(&self.to_le_bytes());
+            }
+            fn get(b: &[u8]) -> Self {
+                let mut a = [0u8; std::mem::size_of::<$t>()];
+                a.copy_from_slice(&b[..std::mem::size_of::<$t>()]);
+                <$t>::from_le_bytes(a)
+            }
+        }
+    )*};
 }
 
-impl Plain for u32 {
-    const BYTES: usize = 4;
-    fn put(self, out: &mut Vec<u8>) {
-        out.extend_from_slice(&self.to_le_bytes());
-    }
-    fn get(b: &[u8]) -> Self {
-        u32::from_le_bytes([b[0], b[1], b[2], b[3]])
-    }
-}
-
-impl Plain for u16 {
-    const BYTES: usize = 2;
-    fn put(self, out: &mut Vec<u8>) {
-        out.extend_from_slice(&self.to_le_bytes());
-    }
-    fn get(b: &[u8]) -> Self {
-        u16::from_le_bytes([b[0], b[1]])
-    }
-}
-
-impl Plain for i16 {
-    const BYTES: usize = 2;
-    fn put(self, out: &mut Vec<u8>) {
-        out.extend_from_slice(&self.to_le_bytes());
-    }
-    fn get(b: &[u8]) -> Self {
-        i16::from_le_bytes([b[0], b[1]])
-    }
-}
-
-impl Plain for u8 {
-    const BYTES: usize = 1;
-    fn put(self, out: &mut Vec<u8>) {
-        out.push(self);
-    }
-    fn get(b: &[u8]) -> Self {
-        b[0]
-    }
-}
+plain_le!(f32, u32, u16, i16, u8);
 
 impl Plain for bool {
     const BYTES: usize = 1;
