@@ -111,21 +111,117 @@ pub fn decode_raster(path: &Path, bytes: &[u8]) -> Result<image::DynamicImage> {
     reader.decode().map_err(|e| bad(&e))
 }
 
+/// What `flourish trace` reads from a file: layers of ink with an SDF each,
+/// or, for a binary bitmap traced as one layer, the smooth outline it stands
+/// for (fitted directly; no SDF is built).
+#[derive(Clone, Debug)]
+pub enum Traceable {
+    /// Layers with signed distance fields.
+    Field(Ink),
+    /// A binary bitmap's smooth outline.
+    Outline(OutlineInk),
+}
+
+/// A binary bitmap read as its smooth outline (see [`super::binary`]).
+#[derive(Clone, Debug)]
+pub struct OutlineInk {
+    /// Width in pixels.
+    pub width: f64,
+    /// Height in pixels.
+    pub height: f64,
+    /// The ink's colour.
+    pub color: Color,
+    /// The outline's closed loops, in pixel coordinates.
+    pub loops: Vec<super::binary::SmoothLoop>,
+}
+
+/// Reads `path` for tracing: like [`load`], except that a binary bitmap
+/// (traced as one layer) comes back as its smooth outline.
+pub fn load_traceable(path: &Path, opts: &InputOptions) -> Result<Traceable> {
+    let bytes = io::read_file(path)?;
+    if looks_like_svg(&bytes) {
+        return load_svg(path, &bytes, opts).map(Traceable::Field);
+    }
+    match raster_coverage(path, &bytes, opts)? {
+        RasterCoverage::Binary { w, h, color, cov } => Ok(Traceable::Outline(OutlineInk {
+            width: w as f64,
+            height: h as f64,
+            color,
+            loops: super::binary::smooth_loops(&cov),
+        })),
+        other => Ok(Traceable::Field(other.into_ink())),
+    }
+}
+
+/// A decoded raster's ink coverage, before any SDF is built.
+enum RasterCoverage {
+    /// One layer of exactly 0/1 coverage.
+    Binary {
+        w: usize,
+        h: usize,
+        color: Color,
+        cov: Coverage,
+    },
+    /// Layers (bottom first) of fractional coverage.
+    Layers {
+        w: usize,
+        h: usize,
+        layers: Vec<(Color, Coverage)>,
+    },
+}
+
+impl RasterCoverage {
+    /// Each layer's SDF: a binary layer's from its smooth outline, others
+    /// from their anti-aliased coverage.
+    fn into_ink(self) -> Ink {
+        let to_user = Affine::IDENTITY;
+        let (w, h, layers) = match self {
+            RasterCoverage::Binary { w, h, color, cov } => (
+                w,
+                h,
+                vec![InkLayer {
+                    color,
+                    sdf: super::binary::sdf(&cov, to_user),
+                }],
+            ),
+            RasterCoverage::Layers { w, h, layers } => (
+                w,
+                h,
+                layers
+                    .into_iter()
+                    .map(|(color, cov)| InkLayer {
+                        color,
+                        sdf: Sdf::from_coverage(&cov, to_user),
+                    })
+                    .collect(),
+            ),
+        };
+        Ink {
+            width: w as f64,
+            height: h as f64,
+            layers,
+        }
+    }
+}
+
 /// Raster bytes (PNG, JPEG, …) read from `path` as ink, as [`load`] reads them.
 pub fn load_raster(path: &Path, bytes: &[u8], opts: &InputOptions) -> Result<Ink> {
+    Ok(raster_coverage(path, bytes, opts)?.into_ink())
+}
+
+/// Decodes raster bytes into ink coverage: alpha or darkness, one layer or
+/// quantized colour layers.
+fn raster_coverage(path: &Path, bytes: &[u8], opts: &InputOptions) -> Result<RasterCoverage> {
     let img = decode_raster(path, bytes)?.to_rgba8();
     let (w, h) = (img.width() as usize, img.height() as usize);
     let has_alpha = img.pixels().any(|p| p[3] < 255);
     let px: Vec<[u8; 4]> = img.pixels().map(|p| p.0).collect();
-    let to_user = Affine::IDENTITY;
-    let layers = if opts.layers {
-        quantized_layers(&px, w, h, has_alpha, opts.invert)
-            .into_iter()
-            .map(|(color, cov)| InkLayer {
-                color,
-                sdf: Sdf::from_coverage(&cov, to_user),
-            })
-            .collect()
+    if opts.layers {
+        Ok(RasterCoverage::Layers {
+            w,
+            h,
+            layers: quantized_layers(&px, w, h, has_alpha, opts.invert),
+        })
     } else {
         let cov = Grid::from_vec(
             w,
@@ -150,18 +246,16 @@ pub fn load_raster(path: &Path, bytes: &[u8], opts: &InputOptions) -> Result<Ink
         // A binary bitmap stands for a smooth outline within half a pixel
         // of its staircase (see `binary`); anti-aliased coverage says where
         // the edge is.
-        let sdf = if super::binary::is_binary(&cov) {
-            super::binary::sdf(&cov, to_user)
+        Ok(if super::binary::is_binary(&cov) {
+            RasterCoverage::Binary { w, h, color, cov }
         } else {
-            Sdf::from_coverage(&cov, to_user)
-        };
-        vec![InkLayer { color, sdf }]
-    };
-    Ok(Ink {
-        width: w as f64,
-        height: h as f64,
-        layers,
-    })
+            RasterCoverage::Layers {
+                w,
+                h,
+                layers: vec![(color, cov)],
+            }
+        })
+    }
 }
 
 fn luma(p: &[u8; 4]) -> f32 {

@@ -5,7 +5,10 @@
 //! [`ParamCurveFit`] source: positions along the polygon by arc length, and
 //! tangents perpendicular to the SDF gradient, which is smooth where the
 //! outline is, so pieces join with G1 continuity. `fit_to_bezpath_opt`
-//! then finds the fewest cubics within the tolerance. Corners are the
+//! then finds the fewest cubics within the tolerance. An outline known
+//! exactly (a binary bitmap's smoothed outline) is fitted the same way by
+//! [`fit_outline`], with its own tangents and corners, and each curve is
+//! checked against the outline itself instead of an SDF. Corners are the
 //! vertices where the outline turns sharply within a pixel-scale window;
 //! the curves meet there at an angle, so sharp corners stay sharp.
 
@@ -32,13 +35,28 @@ const CORNER_SEPARATION: f64 = 0.9;
 /// instead of the SDF gradient.
 const CORNER_REACH: f64 = 1.5;
 
+/// What a piece is fitted to: where its tangents come from and what the
+/// fitted curves are checked against.
+#[derive(Clone, Copy)]
+enum Guide<'a> {
+    /// A marching-squares contour of this SDF's zero level set: tangents
+    /// perpendicular to the gradient, curves checked by |SDF|.
+    Field(&'a Sdf),
+    /// An exact smooth outline (a binary bitmap's, see
+    /// [`crate::raster::binary`]): tangents given per vertex, curves checked
+    /// by their distance to the piece's own polyline.
+    Outline,
+}
+
 /// One piece of a closed contour between corners (or the whole contour),
 /// parameterized by normalized arc length.
 struct Piece<'a> {
     pts: Vec<Point>,
+    /// Unit tangent at each vertex ([`Guide::Outline`] only, else empty).
+    tangents: Vec<Vec2>,
     /// Cumulative arc length at each vertex.
     cum: Vec<f64>,
-    sdf: &'a Sdf,
+    guide: Guide<'a>,
     corner_start: bool,
     corner_end: bool,
     /// The fitter sees coordinates relative to this point: kurbo's moment
@@ -47,7 +65,13 @@ struct Piece<'a> {
 }
 
 impl<'a> Piece<'a> {
-    fn new(pts: Vec<Point>, sdf: &'a Sdf, corner_start: bool, corner_end: bool) -> Self {
+    fn new(
+        pts: Vec<Point>,
+        tangents: Vec<Vec2>,
+        guide: Guide<'a>,
+        corner_start: bool,
+        corner_end: bool,
+    ) -> Self {
         let mut cum = Vec::with_capacity(pts.len());
         let mut s = 0.0;
         cum.push(0.0);
@@ -58,8 +82,9 @@ impl<'a> Piece<'a> {
         let origin = pts.first().map(|p| p.to_vec2()).unwrap_or_default();
         Piece {
             pts,
+            tangents,
             cum,
-            sdf,
+            guide,
             corner_start,
             corner_end,
             origin,
@@ -68,6 +93,77 @@ impl<'a> Piece<'a> {
 
     fn length(&self) -> f64 {
         *self.cum.last().unwrap_or(&0.0)
+    }
+
+    /// The vertices `range` (inclusive) as a piece of their own.
+    fn sub(&self, first: usize, last: usize, corner_start: bool, corner_end: bool) -> Piece<'a> {
+        let tangents = if self.tangents.is_empty() {
+            Vec::new()
+        } else {
+            self.tangents[first..=last].to_vec()
+        };
+        Piece::new(
+            self.pts[first..=last].to_vec(),
+            tangents,
+            self.guide,
+            corner_start,
+            corner_end,
+        )
+    }
+
+    /// The given tangents interpolated along segment `i` at arc length `s`.
+    fn given_tangent(&self, i: usize, s: f64) -> Option<Vec2> {
+        let t0 = *self.tangents.get(i)?;
+        let t1 = *self.tangents.get(i + 1)?;
+        let seg = self.cum[i + 1] - self.cum[i];
+        let f = if seg > 0.0 {
+            ((s - self.cum[i]) / seg).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let t = t0.lerp(t1, f);
+        let l = t.hypot();
+        (l > 1e-9).then(|| t / l)
+    }
+
+    /// Whether every point of `pts` lies within `limit` px of what the piece
+    /// is fitted to, over arc lengths `s0..s1`: the SDF's zero level set, or
+    /// the piece's own outline there (and a pixel either side).
+    fn holds(&self, pts: impl Iterator<Item = Point>, s0: f64, s1: f64, limit: f64) -> bool {
+        match self.guide {
+            Guide::Field(sdf) => {
+                let limit = limit + CHECK_SLACK;
+                let mut pts = pts;
+                pts.all(|p| sdf.value(p).abs() <= limit)
+            }
+            Guide::Outline => {
+                let lo = self.locate(s0 - 1.0).0;
+                let hi = self.locate(s1 + 1.0).0;
+                let dist = |j: usize, p: Point| {
+                    crate::raster::sdf::point_segment_distance(
+                        p,
+                        kurbo::Line::new(self.pts[j], self.pts[j + 1]),
+                    )
+                };
+                let limit = limit + OUTLINE_SLACK;
+                // Consecutive points are usually near the same segment: try
+                // the last one found first.
+                let mut cursor = lo;
+                let mut pts = pts;
+                pts.all(|p| {
+                    if dist(cursor, p) <= limit {
+                        return true;
+                    }
+                    match (lo..=hi).find(|&j| dist(j, p) <= limit) {
+                        Some(j) => {
+                            cursor = j;
+                            true
+                        }
+                        None => false,
+                    }
+                })
+            }
+        }
     }
 
     /// Segment index and position at arc length `s`.
@@ -127,16 +223,22 @@ impl ParamCurveFit for Piece<'_> {
         let len = self.length();
         let near_start = self.corner_start && s < CORNER_REACH;
         let near_end = self.corner_end && len - s < CORNER_REACH;
+        let given = match self.guide {
+            Guide::Outline => self.given_tangent(i, s),
+            Guide::Field(_) => None,
+        };
         let tangent = if (at_start && self.corner_start) || (at_end && self.corner_end) {
             // At a corner the gradient is undefined: use the side's chord.
             self.chord_dir(s, at_start || sign > 0.0 && !at_end)
+        } else if let Some(t) = given {
+            t
         } else if near_start || near_end {
             // Near a convex corner the distance field rounds off (its
             // gradient points at the corner), so the polygon's own
             // direction is the better tangent there.
             self.chord_dir(s, near_start)
-        } else {
-            let g = self.sdf.gradient(p);
+        } else if let Guide::Field(sdf) = self.guide {
+            let g = sdf.gradient(p);
             let perp = Vec2::new(-g.y, g.x);
             let l = perp.hypot();
             if l > 1e-6 {
@@ -149,6 +251,8 @@ impl ParamCurveFit for Piece<'_> {
             } else {
                 travel
             }
+        } else {
+            travel
         };
         CurveFitSample {
             p: p - self.origin,
@@ -234,42 +338,80 @@ pub fn corners(pts: &[Point]) -> Vec<usize> {
     out
 }
 
-/// Fits a closed contour (pixel coordinates) with cubic Béziers within
-/// `accuracy` px, appending a closed subpath to `out`.
+/// Fits a closed contour (pixel coordinates) of `sdf`'s zero level set with
+/// cubic Béziers within `accuracy` px, appending a closed subpath to `out`.
+/// Corners are found by [`corners`].
 pub fn fit_contour(pts: &[Point], sdf: &Sdf, accuracy: f64, out: &mut BezPath) {
-    let n = pts.len();
-    if n < 3 {
+    if pts.len() < 3 {
         return;
     }
-    let cs = corners(pts);
+    fit_loop(pts, &[], &corners(pts), Guide::Field(sdf), accuracy, out);
+}
+
+/// Fits a closed smooth outline (pixel coordinates) with cubic Béziers
+/// within `accuracy` px of it, appending a closed subpath to `out`:
+/// `tangents` are the outline's unit tangents at its points and `corners`
+/// the indices (ascending) where it turns sharply. This is the direct path
+/// for outlines known exactly (a binary bitmap's, see
+/// [`crate::raster::binary::SmoothLoop`]), with no SDF in between.
+pub fn fit_outline(
+    pts: &[Point],
+    tangents: &[Vec2],
+    corners: &[usize],
+    accuracy: f64,
+    out: &mut BezPath,
+) {
+    if pts.len() < 3 || tangents.len() != pts.len() {
+        return;
+    }
+    let corners: Vec<usize> = corners.iter().copied().filter(|&c| c < pts.len()).collect();
+    fit_loop(pts, tangents, &corners, Guide::Outline, accuracy, out);
+}
+
+/// The closed loop `pts` cut at `cs` into pieces, each fitted.
+fn fit_loop(
+    pts: &[Point],
+    tangents: &[Vec2],
+    cs: &[usize],
+    guide: Guide,
+    accuracy: f64,
+    out: &mut BezPath,
+) {
+    let n = pts.len();
+    let tan_of = |idx: &[usize]| -> Vec<Vec2> {
+        if tangents.is_empty() {
+            Vec::new()
+        } else {
+            idx.iter().map(|&i| tangents[i]).collect()
+        }
+    };
     let mut pieces: Vec<Piece> = Vec::new();
     if cs.is_empty() {
         // A smooth loop is fitted as two open halves (kurbo's fitter needs
-        // distinct end points); the tangents at the joins come from the SDF,
-        // so the halves meet with G1 continuity.
+        // distinct end points); the tangents at the joins come from the
+        // guide, so the halves meet with G1 continuity.
         let h = n / 2;
-        let mut second: Vec<Point> = pts[h..].to_vec();
-        second.push(pts[0]);
-        pieces.push(Piece::new(pts[..=h].to_vec(), sdf, false, false));
-        pieces.push(Piece::new(second, sdf, false, false));
+        let first: Vec<usize> = (0..=h).collect();
+        let second: Vec<usize> = (h..n).chain([0]).collect();
+        for idx in [first, second] {
+            let p = idx.iter().map(|&i| pts[i]).collect();
+            pieces.push(Piece::new(p, tan_of(&idx), guide, false, false));
+        }
     } else {
         for k in 0..cs.len() {
             let a = cs[k];
             let b = cs[(k + 1) % cs.len()];
-            let mut seg = Vec::new();
-            let mut i = a;
+            let mut idx = vec![a];
+            let mut i = (a + 1) % n;
             loop {
-                seg.push(pts[i]);
-                if i == b && seg.len() > 1 {
+                idx.push(i);
+                if i == b {
                     break;
                 }
                 i = (i + 1) % n;
-                if i == b {
-                    seg.push(pts[i]);
-                    break;
-                }
             }
-            pieces.push(Piece::new(seg, sdf, true, true));
+            let p = idx.iter().map(|&i| pts[i]).collect();
+            pieces.push(Piece::new(p, tan_of(&idx), guide, true, true));
         }
     }
     let mut first = true;
@@ -313,12 +455,7 @@ const MAX_PIECE_TURN: f64 = std::f64::consts::FRAC_PI_2;
 fn split_by_turning<'a>(piece: &Piece<'a>) -> Vec<Piece<'a>> {
     let n = piece.pts.len();
     if n < 4 {
-        return vec![Piece::new(
-            piece.pts.clone(),
-            piece.sdf,
-            piece.corner_start,
-            piece.corner_end,
-        )];
+        return vec![piece.sub(0, n - 1, piece.corner_start, piece.corner_end)];
     }
     // Turning is accumulated between chords of about 3 px, which follow the
     // outline's shape and not the sub-pixel wobble of its vertices.
@@ -359,9 +496,9 @@ fn split_by_turning<'a>(piece: &Piece<'a>) -> Vec<Piece<'a>> {
     cuts.push(n - 1);
     cuts.windows(2)
         .map(|w| {
-            Piece::new(
-                piece.pts[w[0]..=w[1]].to_vec(),
-                piece.sdf,
+            piece.sub(
+                w[0],
+                w[1],
                 w[0] == 0 && piece.corner_start,
                 w[1] == n - 1 && piece.corner_end,
             )
@@ -372,6 +509,10 @@ fn split_by_turning<'a>(piece: &Piece<'a>) -> Vec<Piece<'a>> {
 /// Extra distance (px) allowed between a fitted curve and the level set
 /// beyond the fitting accuracy, for the bilinear interpolation of the SDF.
 pub const CHECK_SLACK: f64 = 0.04;
+
+/// Extra distance (px) allowed between a fitted curve and an exact outline
+/// beyond the fitting accuracy: the outline's own flattening.
+const OUTLINE_SLACK: f64 = 0.02;
 
 /// Fits one piece with as few cubics as a greedy cover finds: from the
 /// start of what is left, the longest span that one cubic fits (kurbo's
@@ -463,10 +604,12 @@ fn fit_span(piece: &Piece, range: Range<f64>, accuracy: f64) -> Option<CubicBez>
                 crate::raster::sdf::point_segment_distance(p, chord) <= CHORD_SHARE * accuracy
             });
         let on_level_set = || {
-            (1..64).all(|k| {
-                piece.sdf.value(a.lerp(b, k as f64 / 64.0)).abs()
-                    <= CHORD_SHARE * accuracy + CHECK_SLACK
-            })
+            piece.holds(
+                (1..64).map(|k| a.lerp(b, k as f64 / 64.0)),
+                s0,
+                s1,
+                CHORD_SHARE * accuracy,
+            )
         };
         (a != b && within && on_level_set()).then(|| line_cubic(a, b))
     })
@@ -505,10 +648,11 @@ fn fit_checked(piece: &Piece, range: Range<f64>, accuracy: f64) -> Option<CubicB
     if is_spicy(piece, range.clone()) {
         return None;
     }
-    let (c, _) = kurbo::fit_to_cubic(piece, range, accuracy)?;
+    let (c, _) = kurbo::fit_to_cubic(piece, range.clone(), accuracy)?;
     let c = Affine::translate(piece.origin) * c;
-    let ok = (1..64)
-        .all(|k| piece.sdf.value(c.eval(k as f64 / 64.0)).abs() <= accuracy + CHECK_SLACK)
+    let s0 = range.start * piece.length();
+    let s1 = range.end * piece.length();
+    let ok = piece.holds((1..64).map(|k| c.eval(k as f64 / 64.0)), s0, s1, accuracy)
         && c.arclen(0.01) <= 1.5 * len + 0.5;
     ok.then_some(c)
 }

@@ -14,11 +14,12 @@ pub mod contour;
 pub mod fit;
 
 use crate::error::{Error, Result};
-use crate::raster::input::{self, Ink, InputOptions};
+use crate::raster::binary::SmoothLoop;
+use crate::raster::input::{self, Ink, InputOptions, Traceable};
 use crate::raster::Sdf;
 use crate::svg_out::{decimals_for, Document, FillRule, Group, Shape};
 use contour::{contains, Contour};
-use kurbo::{BezPath, Rect};
+use kurbo::{BezPath, Point, Rect};
 use rayon::prelude::*;
 use std::path::Path;
 
@@ -73,46 +74,60 @@ pub struct Island {
 /// boundary containing it. Contours with |area| below `min_area` px² are
 /// dropped (an island's holes go with it). Order follows the input.
 pub fn nest(contours: Vec<Contour>, min_area: f64) -> Vec<Island> {
+    let polys: Vec<&[Point]> = contours.iter().map(|c| c.points.as_slice()).collect();
+    let groups = nest_polygons(&polys, min_area);
+    let mut slots: Vec<Option<Contour>> = contours.into_iter().map(Some).collect();
+    groups
+        .into_iter()
+        .filter_map(|(o, hs)| {
+            let outer = slots[o].take()?;
+            let holes = hs.into_iter().filter_map(|h| slots[h].take()).collect();
+            Some(Island { outer, holes })
+        })
+        .collect()
+}
+
+/// [`nest`] on bare closed polygons: `(outer, holes)` as indices into
+/// `polys`, outers in input order.
+pub fn nest_polygons(polys: &[&[Point]], min_area: f64) -> Vec<(usize, Vec<usize>)> {
     let mut outers = Vec::new();
     let mut holes = Vec::new();
-    for c in contours {
-        let a = c.signed_area();
+    for (i, pts) in polys.iter().enumerate() {
+        if pts.is_empty() {
+            continue;
+        }
+        let a = contour::signed_area(pts);
         if a.abs() < min_area {
             continue;
         }
-        let bbox = bounds(&c);
+        let bbox = bounds(pts);
         if a > 0.0 {
-            outers.push((c, bbox, a));
+            outers.push((i, bbox, a));
         } else {
-            holes.push((c, bbox));
+            holes.push((i, bbox));
         }
     }
-    let mut islands: Vec<Island> = outers
-        .iter()
-        .map(|(c, _, _)| Island {
-            outer: c.clone(),
-            holes: Vec::new(),
-        })
-        .collect();
+    let mut islands: Vec<(usize, Vec<usize>)> =
+        outers.iter().map(|&(i, _, _)| (i, Vec::new())).collect();
     for (h, hb) in holes {
-        let probe = h.points[0];
+        let probe = polys[h][0];
         let owner = outers
             .iter()
             .enumerate()
             .filter(|(_, (_, ob, _))| ob.contains(probe) && ob.union(hb) == *ob)
-            .filter(|(_, (o, _, _))| contains(&o.points, probe))
+            .filter(|(_, (o, _, _))| contains(polys[*o], probe))
             .min_by(|a, b| a.1 .2.total_cmp(&b.1 .2))
-            .map(|(i, _)| i);
-        if let Some(i) = owner {
-            islands[i].holes.push(h);
+            .map(|(k, _)| k);
+        if let Some(k) = owner {
+            islands[k].1.push(h);
         }
     }
     islands
 }
 
-fn bounds(c: &Contour) -> Rect {
+fn bounds(pts: &[Point]) -> Rect {
     let mut r = Rect::new(f64::MAX, f64::MAX, f64::MIN, f64::MIN);
-    for p in &c.points {
+    for p in pts {
         r.x0 = r.x0.min(p.x);
         r.y0 = r.y0.min(p.y);
         r.x1 = r.x1.max(p.x);
@@ -134,6 +149,31 @@ pub fn trace_sdf(sdf: &Sdf, opts: &TraceOptions) -> Vec<BezPath> {
                 fit::fit_contour(&h.points, sdf, opts.tolerance, &mut path);
             }
             sdf.to_user * path
+        })
+        .collect()
+}
+
+/// Traces a binary bitmap's smooth outline (see [`crate::raster::binary`])
+/// directly: one closed Bézier path per island, in pixel units. The curves
+/// stay within `opts.tolerance` of the outline itself, with no SDF and no
+/// second contour extraction in between.
+pub fn trace_outline(loops: &[SmoothLoop], opts: &TraceOptions) -> Vec<BezPath> {
+    let polys: Vec<&[Point]> = loops.iter().map(|l| l.points.as_slice()).collect();
+    nest_polygons(&polys, opts.min_area)
+        .par_iter()
+        .map(|(outer, holes)| {
+            let mut path = BezPath::new();
+            for &i in std::iter::once(outer).chain(holes) {
+                let l = &loops[i];
+                fit::fit_outline(
+                    &l.points,
+                    &l.tangents,
+                    &l.corners,
+                    opts.tolerance,
+                    &mut path,
+                );
+            }
+            path
         })
         .collect()
 }
@@ -172,9 +212,28 @@ pub fn trace_ink(ink: &Ink, opts: &TraceOptions) -> Result<Document> {
 }
 
 /// Reads `path` (raster or SVG) and traces it: the library side of
-/// `flourish trace`.
+/// `flourish trace`. A binary bitmap is traced from its smooth outline
+/// ([`trace_outline`]); anything else from its SDF.
 pub fn trace_file(path: &Path, input: &InputOptions, opts: &TraceOptions) -> Result<Document> {
     opts.validate()?;
-    let ink = input::load(path, input)?;
-    trace_ink(&ink, opts)
+    match input::load_traceable(path, input)? {
+        Traceable::Field(ink) => trace_ink(&ink, opts),
+        Traceable::Outline(o) => {
+            let mut doc = Document::new(o.width, o.height, decimals_for(opts.tolerance));
+            let paths = trace_outline(&o.loops, opts);
+            if !paths.is_empty() {
+                doc.groups.push(Group {
+                    id: "layer-1".into(),
+                    shapes: paths
+                        .into_iter()
+                        .map(|p| Shape {
+                            fill_rule: FillRule::NonZero,
+                            ..Shape::filled(p, o.color)
+                        })
+                        .collect(),
+                });
+            }
+            Ok(doc)
+        }
+    }
 }

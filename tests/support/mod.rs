@@ -581,15 +581,30 @@ pub fn raw_segment_count(svg: &str) -> usize {
     n
 }
 
-/// Traces `png` with `flourish::trace::trace_file` and default options:
+/// The trace options the comparison uses: the defaults, with the tolerance
+/// taken from `FLOURISH_TOLERANCE` (px) when that is set, so the example can
+/// show the segments/deviation trade-off.
+pub fn flourish_options() -> TraceOptions {
+    let mut o = TraceOptions::default();
+    if let Some(t) = std::env::var("FLOURISH_TOLERANCE")
+        .ok()
+        .and_then(|v| v.parse::<f64>().ok())
+    {
+        o.tolerance = t;
+    }
+    o
+}
+
+/// Traces `png` with `flourish::trace::trace_file` and [`flourish_options`]:
 /// the document and the median in-process time of `runs` runs.
 pub fn run_flourish(png: &Path, runs: usize) -> (Document, Duration) {
     let mut times = Vec::new();
     let mut doc = None;
+    let opts = flourish_options();
     for _ in 0..runs.max(1) {
         let t = Instant::now();
-        let d = flourish::trace::trace_file(png, &Default::default(), &TraceOptions::default())
-            .expect("flourish trace");
+        let d =
+            flourish::trace::trace_file(png, &Default::default(), &opts).expect("flourish trace");
         times.push(t.elapsed());
         doc = Some(d);
     }
