@@ -15,7 +15,9 @@
 //! - [`quilt`]: image-quilting initialization;
 //! - [`patchmatch`]: rotated-patch nearest neighbours;
 //! - [`levelset`]: narrow-band evolution of the SDF channels;
-//! - [`em`]: the multiresolution loop and voting.
+//! - [`em`]: the multiresolution loop and voting;
+//! - [`continuity`]: band ends, forks and gap regularity of a result (the
+//!   measure of the tears patch synthesis makes).
 //!
 //! Each layer's synthesized SDF is clipped to the region (`max(Φ, Φ_region)`,
 //! exact since both are distances), kept under the layers above it, traced
@@ -25,6 +27,7 @@
 //! seamless and have no boundary of their own to match; the colour warp by
 //! the level-set deformation field (§2, last paragraph), replaced by voting.
 
+pub mod continuity;
 pub mod em;
 pub mod levelset;
 pub mod patchmatch;
