@@ -23,6 +23,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         radius: num(4).unwrap_or(st.params.radius),
         levels: num(5).unwrap_or(st.params.levels),
         iterations: num(6).unwrap_or(st.params.iterations),
+        seed: a.get(12).and_then(|s| s.parse().ok()).unwrap_or(0),
+        shape: a
+            .get(10)
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(st.params.shape),
         ..st.params
     };
     let sk = sketch::load(&root.join("samples/fill").join(format!("{sample}.svg")))?;
@@ -50,6 +55,29 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             [t.cos(), t.sin()],
         );
     }
+    if a.get(11).is_some() {
+        let o = flourish::fill::FillOptions {
+            style: style.into(),
+            ..Default::default()
+        };
+        let out = flourish::fill::fill_sketch(&o, &sk)?;
+        let r = &out.regions[0];
+        let img = image::GrayImage::from_fn(
+            r.layers[0].width() as u32,
+            r.layers[0].height() as u32,
+            |x, y| {
+                let v = r
+                    .layers
+                    .iter()
+                    .map(|l| l.get(x as usize, y as usize) < 0.0)
+                    .filter(|&b| b)
+                    .count();
+                image::Luma([255 - 120 * v as u8])
+            },
+        );
+        img.save("/tmp/fd/sketch.png")?;
+        eprintln!("pipeline energy {:?}", r.energy);
+    }
     let t0 = Instant::now();
     let s = synthesize_in(&st.tile, &region.direction, Some(&region.mask), &params);
     eprintln!(
@@ -59,6 +87,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         s.energy
     );
     let (w, h) = (region.width(), region.height());
+    let rim: Vec<bool> = (0..w * h)
+        .filter(|&i| (-4.0..-1.0).contains(&region.sdf.dist.data()[i]))
+        .map(|i| s.layers[0].data()[i] < 0.0)
+        .collect();
+    println!(
+        "rim ink {:.3} (edge {:?})",
+        rim.iter().filter(|&&b| b).count() as f64 / rim.len() as f64,
+        st.tile.edge
+    );
     let layer = num(9).unwrap_or(s.layers.len() - 1);
     let ink = flourish::raster::Grid::from_fn(w, h, |x, y| {
         s.layers[layer].get(x, y) < 0.0 && region.mask.get(x, y)

@@ -16,8 +16,9 @@
 //! M-step is recorded per level, so its decrease can be checked.
 
 use super::levelset::{self, Evolution};
-use super::patchmatch::{Channels, Match, Nnf, Patch, Problem};
+use super::patchmatch::{Channels, Match, Nnf, Patch, Problem, ShapeTerm};
 use super::quilt::{self, QuiltOptions};
+use super::shape::{self, ShapeHint};
 use super::tile::Tile;
 use crate::field::DirectionGrid;
 use crate::raster::Grid;
@@ -38,6 +39,10 @@ pub struct EmParams {
     pub steps: usize,
     /// Seed of every random choice.
     pub seed: u64,
+    /// Weight of the Shape Hint term (Brushables Eq. 6) per patch pixel:
+    /// the χ² of two descriptors is weighted `shape · (2r+1)²` against the
+    /// patch SSD. 0 leaves it out.
+    pub shape: f32,
 }
 
 impl Default for EmParams {
@@ -49,6 +54,7 @@ impl Default for EmParams {
             iterations: 4,
             steps: 5,
             seed: 0,
+            shape: 0.25,
         }
     }
 }
@@ -110,13 +116,13 @@ pub fn synthesize_in(
         let source_angle = t.direction.map(|d| d[1].atan2(d[0]));
         // Squared distance to the region at this level (any pixel of a
         // block counts).
-        let near = mask.map(|m| {
-            let lm = Grid::from_fn(w, h, |x, y| {
+        let level_mask = mask.map(|m| {
+            Grid::from_fn(w, h, |x, y| {
                 (y * f..((y + 1) * f).min(height))
                     .any(|yy| (x * f..((x + 1) * f).min(width)).any(|xx| m.get(xx, yy)))
-            });
-            crate::raster::edt::squared_edt(&lm)
+            })
         });
+        let near = level_mask.as_ref().map(crate::raster::edt::squared_edt);
         // Neighbourhood sizes: at the coarsest level a larger one first.
         let max_r = (t.width().min(t.height()) / 4).max(1);
         let mut radii = vec![params.radius.min(max_r).max(1)];
@@ -195,6 +201,17 @@ pub fn synthesize_in(
                 params.iterations
             }
             .max(1);
+            // Shape Hint descriptors (ring of radius r, bins r/2) of the
+            // tile's edge line and of the region's outline.
+            let hints = match (&level_mask, &t.edge) {
+                (Some(lm), Some(edge)) if params.shape > 0.0 => {
+                    let (ring, bin) = (r as f32, (r as f32 / 2.0).max(1.0));
+                    let src = ShapeHint::new(&edge.raster(t.width(), t.height()), true, ring, bin);
+                    let tgt = ShapeHint::new(&shape::outline(lm), false, ring, bin);
+                    Some((src.histograms(&source_angle), tgt.histograms(&target_angle)))
+                }
+                _ => None,
+            };
             let (mut lambda, mut mu) = (0.2f32, 0.8f32);
             for it in 0..n {
                 let target = channels_of(&st.phi, &st.colour, params.alpha, clamp);
@@ -210,6 +227,13 @@ pub fn synthesize_in(
                 let mut pb = Problem::new(&source, &source_angle, &target, &target_angle, &patch);
                 if let Some(a) = &active {
                     pb = pb.with_active(a);
+                }
+                if let Some((src, tgt)) = &hints {
+                    pb = pb.with_shape(ShapeTerm {
+                        source: src,
+                        target: tgt,
+                        weight: params.shape * ((2 * r + 1) * (2 * r + 1)) as f32,
+                    });
                 }
                 pb.refresh(&mut field);
                 let round = ((level * 8 + ri) * 64 + it) as u64;
@@ -420,6 +444,11 @@ fn histogram_weights(phi: &[Grid<f32>], t: &Tile, near: Option<&Grid<f32>>) -> V
         .collect()
 }
 
+/// `exp(−d²/2σ_c²)` of Brushables Eq. 8 for the whole squared pixel
+/// distances `d² < 64` (torus offsets are whole pixels).
+static COHERENCE_EXP: std::sync::LazyLock<Vec<f32>> =
+    std::sync::LazyLock::new(|| (0..64).map(|k| (-(k as f32) / (2.0 * 2.0)).exp()).collect());
+
 /// Brushables Eq. 8: how well the rigid maps of neighbouring centres agree
 /// with centre `k`'s own (σ_c² = 2), averaged, plus a floor.
 fn coherence(pb: &Problem, nnf: &Nnf, k: usize) -> f32 {
@@ -445,7 +474,11 @@ fn coherence(pb: &Problem, nnf: &Nnf, k: usize) -> f32 {
             let ex = (px as i64 - o.x as i64).rem_euclid(tw);
             let ey = (py as i64 - o.y as i64).rem_euclid(th);
             let (ex, ey) = (ex.min(tw - ex) as f32, ey.min(th - ey) as f32);
-            sum += (-(ex * ex + ey * ey) / (2.0 * 2.0)).exp();
+            let d2 = ex * ex + ey * ey;
+            sum += COHERENCE_EXP
+                .get(d2 as usize)
+                .copied()
+                .unwrap_or_else(|| (-d2 / (2.0 * 2.0)).exp());
             n += 1;
         }
     }
