@@ -1,8 +1,16 @@
-//! Diagnostics of the fill synthesis on one sample: runs the EM with
-//! parameters from the command line and writes the layers as a PNG.
+//! Diagnostics of the fill synthesis on one sample's first region: runs the
+//! EM with parameters from the command line, writes the layers as a PNG
+//! (outside the region greyed) and the direction field as hues to
+//! `/tmp/fd/direction.png`, and prints the continuity figures of
+//! `fill::continuity` for the result and the tile (band ends, forks, gap
+//! regularity, ink on the rim) and the forced dislocations
+//! `Σ|∇θ| / 17 px`.
 //!
 //! Run: `cargo run --release --example fill_debug STYLE SAMPLE OUT.png
-//! [radius levels iterations resolution]`.
+//! [radius levels iterations resolution direction° layer shape pipeline
+//! seed]`; `-` keeps a default, `direction°` replaces the field by a
+//! constant, `pipeline` (any word) also writes `/tmp/fd/sketch.png` from
+//! the whole `fill_sketch`.
 
 use flourish::fill::em::{synthesize_in, EmParams};
 use flourish::fill::region::Region;
@@ -17,6 +25,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let style = a.get(1).map_or("knot", |s| s.as_str());
     let sample = a.get(2).map_or("circle", |s| s.as_str());
     let out = a.get(3).map_or("/tmp/fill-debug.png", |s| s.as_str());
+    std::fs::create_dir_all("/tmp/fd")?;
     let num = |i: usize| a.get(i).and_then(|s| s.parse::<usize>().ok());
     let st = FillStyle::load(&root.join("styles").join(style), num(7).map(|v| v as u32))?;
     let params = EmParams {

@@ -449,8 +449,10 @@ fn the_knot_stays_continuous_under_constant_turning_and_ring_fields() {
     let r = &out.regions[0];
     let (regular, forks) = continuity_of(&r.layers, &r.region.sdf.dist, tile);
     println!("circle: regular gaps {regular:.3}, forks {forks:.2} per 10⁴ px");
-    assert!(regular >= 0.9, "circle: {regular}");
-    assert!(forks <= 1.0, "circle: {forks}");
+    // (With the tile's x axis as its direction the weave tore into
+    // spirals: 0.906 and 1.54.)
+    assert!(regular >= 0.93, "circle: {regular}");
+    assert!(forks <= 1.2, "circle: {forks}");
 }
 
 /// The knot's circle sample: its style, region and synthesis parameters.
