@@ -12,6 +12,20 @@ use flourish::fill::tile::{SourceDirection, Tile};
 use std::path::PathBuf;
 use std::time::Instant;
 
+/// CPU time of the whole process (all threads), seconds, from
+/// `/proc/self/stat` (utime + stime in clock ticks of 10 ms); 0 elsewhere.
+fn cpu_seconds() -> f64 {
+    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    // Fields after the parenthesized command name; utime and stime are
+    // the 14th and 15th fields of the line.
+    let rest = stat.rsplit_once(')').map_or("", |(_, r)| r);
+    let f: Vec<f64> = rest
+        .split_whitespace()
+        .map(|v| v.parse().unwrap_or(0.0))
+        .collect();
+    (f.get(11).copied().unwrap_or(0.0) + f.get(12).copied().unwrap_or(0.0)) / 100.0
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let tile = args.get(1).map(PathBuf::from).unwrap_or_else(|| {
@@ -28,14 +42,18 @@ fn main() {
     let dir = constant_field(side, side, [1.0, 0.0]);
     let params = EmParams::default();
     let mut times = Vec::new();
+    let mut cpu = Vec::new();
     let mut last = None;
     for _ in 0..5 {
-        let t0 = Instant::now();
+        let (t0, c0) = (Instant::now(), cpu_seconds());
         let s = synthesize(&t, &dir, &params);
         times.push(t0.elapsed().as_secs_f64());
+        cpu.push(cpu_seconds() - c0);
         last = Some(s);
     }
     times.sort_by(f64::total_cmp);
+    cpu.sort_by(f64::total_cmp);
+    println!("CPU time: median {:.2} s (runs {cpu:.2?})", cpu[2]);
     println!(
         "{side}×{side} from {}×{} tile: median {:.3} s (runs {times:.3?})",
         t.width(),

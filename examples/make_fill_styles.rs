@@ -142,15 +142,31 @@ fn star() -> String {
 
 fn main() -> std::io::Result<()> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    for (name, tile, dir) in [
-        ("knot", knot(), "[1.0, 0.0]"),
-        ("scales", scales(), "[1.0, 0.0]"),
+    // The source direction is that of the tile's own bands (Brushables
+    // §3.1), so a curving field bends the bands along it. The knot's bands
+    // run at ±45°: with the x axis as source, a circle's ring-shaped field
+    // turned both families into spirals whose spacing must change with the
+    // radius, and the weave tore everywhere; along one family, that family
+    // becomes unbroken rings and only the other (the spokes) must end.
+    for (name, tile, dir, says) in [
+        (
+            "knot",
+            knot(),
+            "[1.0, -1.0]",
+            "The bands rising to the right follow the region's direction field.",
+        ),
+        (
+            "scales",
+            scales(),
+            "[1.0, 0.0]",
+            "The rows of scales (the tile's x axis) follow the region's direction field.",
+        ),
     ] {
         write(&root.join(format!("styles/{name}/tile.svg")), &tile)?;
         write(
             &root.join(format!("styles/{name}/style.toml")),
             &format!(
-                "# Fill style drawn by examples/make_fill_styles.rs: a seamless {T}×{T} tile.\nkind = \"fill\"\n# Tile pixels on its longest side (1 px per tile unit).\nresolution = 96\n# Sketch units per tile unit.\nscale = 1.0\n# The tile's x axis follows the region's direction field.\ndirection = {dir}\npatch = 9\nlevels = 2\niterations = 4\n\n[[exemplar]]\nfile = \"tile.svg\"\n"
+                "# Fill style drawn by examples/make_fill_styles.rs: a seamless {T}×{T} tile.\nkind = \"fill\"\n# Tile pixels on its longest side (1 px per tile unit).\nresolution = 96\n# Sketch units per tile unit.\nscale = 1.0\n# {says}\ndirection = {dir}\npatch = 9\nlevels = 2\niterations = 4\n\n[[exemplar]]\nfile = \"tile.svg\"\n"
             ),
         )?;
     }

@@ -12,12 +12,14 @@
 //! (the histogram over each layer's ink and paper bins also weights the
 //! SDF votes, so the mean of Eq. 2 keeps the tile's ink fraction).
 //!
-//! The energy (Eq. 6) of the current image against the matches after each
-//! M-step is recorded per level, so its decrease can be checked.
+//! The energy (Eq. 6, with the Shape Hint term near a region's outline) of
+//! the current image against the matches is recorded per level at its
+//! start and after each M-step, so its decrease can be checked.
 
 use super::levelset::{self, Evolution};
-use super::patchmatch::{Channels, Match, Nnf, Patch, Problem};
+use super::patchmatch::{Channels, Match, Nnf, Patch, Problem, ShapeTerm};
 use super::quilt::{self, QuiltOptions};
+use super::shape::{self, ShapeHint};
 use super::tile::Tile;
 use crate::field::DirectionGrid;
 use crate::raster::Grid;
@@ -32,12 +34,18 @@ pub struct EmParams {
     pub radius: usize,
     /// Pyramid levels (1 = finest only).
     pub levels: usize,
-    /// EM iterations `N` per neighbourhood size (halved at the finest level).
+    /// EM iterations `N` per neighbourhood size (a quarter of them at the
+    /// finest level of a pyramid, at least one: CaTS §4.1 reduces the
+    /// iterations at finer levels, whose start is already close).
     pub iterations: usize,
     /// Level-set time steps per E-step (the paper uses 5).
     pub steps: usize,
     /// Seed of every random choice.
     pub seed: u64,
+    /// Weight of the Shape Hint term (Brushables Eq. 6) per patch pixel:
+    /// the χ² of two descriptors is weighted `shape · (2r+1)²` against the
+    /// patch SSD. 0 leaves it out.
+    pub shape: f32,
 }
 
 impl Default for EmParams {
@@ -49,6 +57,7 @@ impl Default for EmParams {
             iterations: 4,
             steps: 5,
             seed: 0,
+            shape: 0.25,
         }
     }
 }
@@ -60,8 +69,9 @@ pub struct Synthesis {
     pub layers: Vec<Grid<f32>>,
     /// Voted colour (0..1 RGB).
     pub colour: Grid<[f32; 3]>,
-    /// Eq. 6 energy after each M-step ([`interior_energy`]), per level
-    /// (coarse first), per neighbourhood size and iteration in order.
+    /// Eq. 6 energy ([`interior_energy`]) per level (coarse first): of the
+    /// level's initial matches, then after each M-step, per neighbourhood
+    /// size and iteration in order.
     pub energy: Vec<Vec<f64>>,
 }
 
@@ -110,13 +120,13 @@ pub fn synthesize_in(
         let source_angle = t.direction.map(|d| d[1].atan2(d[0]));
         // Squared distance to the region at this level (any pixel of a
         // block counts).
-        let near = mask.map(|m| {
-            let lm = Grid::from_fn(w, h, |x, y| {
+        let level_mask = mask.map(|m| {
+            Grid::from_fn(w, h, |x, y| {
                 (y * f..((y + 1) * f).min(height))
                     .any(|yy| (x * f..((x + 1) * f).min(width)).any(|xx| m.get(xx, yy)))
-            });
-            crate::raster::edt::squared_edt(&lm)
+            })
         });
+        let near = level_mask.as_ref().map(crate::raster::edt::squared_edt);
         // Neighbourhood sizes: at the coarsest level a larger one first.
         let max_r = (t.width().min(t.height()) / 4).max(1);
         let mut radii = vec![params.radius.min(max_r).max(1)];
@@ -190,11 +200,22 @@ pub fn synthesize_in(
             let spacing = spacing_of(r);
             let mut field = resample_nnf(nnf.take(), w, h, spacing, t);
             let n = if level == 0 && levels > 1 {
-                params.iterations.div_ceil(2)
+                params.iterations.div_ceil(4)
             } else {
                 params.iterations
             }
             .max(1);
+            // Shape Hint descriptors (ring of radius r, bins r/2) of the
+            // tile's edge line and of the region's outline.
+            let hints = match (&level_mask, &t.edge) {
+                (Some(lm), Some(edge)) if params.shape > 0.0 => {
+                    let (ring, bin) = (r as f32, (r as f32 / 2.0).max(1.0));
+                    let src = ShapeHint::new(&edge.raster(t.width(), t.height()), true, ring, bin);
+                    let tgt = ShapeHint::new(&shape::outline(lm), false, ring, bin);
+                    Some((src.histograms(&source_angle), tgt.histograms(&target_angle)))
+                }
+                _ => None,
+            };
             let (mut lambda, mut mu) = (0.2f32, 0.8f32);
             for it in 0..n {
                 let target = channels_of(&st.phi, &st.colour, params.alpha, clamp);
@@ -211,7 +232,19 @@ pub fn synthesize_in(
                 if let Some(a) = &active {
                     pb = pb.with_active(a);
                 }
+                if let Some((src, tgt)) = &hints {
+                    pb = pb.with_shape(ShapeTerm {
+                        source: src,
+                        target: tgt,
+                        weight: params.shape * ((2 * r + 1) * (2 * r + 1)) as f32,
+                    });
+                }
                 pb.refresh(&mut field);
+                if ri == 0 && it == 0 {
+                    // The level's starting energy: the initial matches
+                    // against the quilted or upsampled image.
+                    level_energy.push(interior_energy(&field, r, w, h, active.as_deref()));
+                }
                 let round = ((level * 8 + ri) * 64 + it) as u64;
                 pb.improve(&mut field, params.seed, round);
                 level_energy.push(interior_energy(&field, r, w, h, active.as_deref()));
@@ -420,6 +453,11 @@ fn histogram_weights(phi: &[Grid<f32>], t: &Tile, near: Option<&Grid<f32>>) -> V
         .collect()
 }
 
+/// `exp(−d²/2σ_c²)` of Brushables Eq. 8 for the whole squared pixel
+/// distances `d² < 64` (torus offsets are whole pixels).
+static COHERENCE_EXP: std::sync::LazyLock<Vec<f32>> =
+    std::sync::LazyLock::new(|| (0..64).map(|k| (-(k as f32) / (2.0 * 2.0)).exp()).collect());
+
 /// Brushables Eq. 8: how well the rigid maps of neighbouring centres agree
 /// with centre `k`'s own (σ_c² = 2), averaged, plus a floor.
 fn coherence(pb: &Problem, nnf: &Nnf, k: usize) -> f32 {
@@ -429,6 +467,10 @@ fn coherence(pb: &Problem, nnf: &Nnf, k: usize) -> f32 {
     let (tw, th) = (pb.source.width as i64, pb.source.height as i64);
     let (ci, cj) = (k % nnf.cols, k / nnf.cols);
     let reach = (r / nnf.spacing).max(1);
+    // Neighbours lie within the patch: their rotated offsets are in the
+    // patch's table for the centre's angle bin.
+    let table = pb.patch.table(pb.bin(m.x as usize, m.y as usize, qx, qy));
+    let side = 2 * r as i32 + 1;
     let (mut sum, mut n) = (0.0f32, 0u32);
     for j in cj.saturating_sub(reach)..=(cj + reach).min(nnf.rows - 1) {
         for i in ci.saturating_sub(reach)..=(ci + reach).min(nnf.cols - 1) {
@@ -440,12 +482,18 @@ fn coherence(pb: &Problem, nnf: &Nnf, k: usize) -> f32 {
                 (i * nnf.spacing) as i32 - qx as i32,
                 (j * nnf.spacing) as i32 - qy as i32,
             );
-            let (px, py) = pb.map(qx, qy, m.x as usize, m.y as usize, dx, dy);
+            let Some(e) = table.get(((dy + r as i32) * side + dx + r as i32) as usize) else {
+                continue;
+            };
             // Torus distance between the two images of the neighbour.
-            let ex = (px as i64 - o.x as i64).rem_euclid(tw);
-            let ey = (py as i64 - o.y as i64).rem_euclid(th);
+            let ex = (m.x as i64 + e.2 as i64 - o.x as i64).rem_euclid(tw);
+            let ey = (m.y as i64 + e.3 as i64 - o.y as i64).rem_euclid(th);
             let (ex, ey) = (ex.min(tw - ex) as f32, ey.min(th - ey) as f32);
-            sum += (-(ex * ex + ey * ey) / (2.0 * 2.0)).exp();
+            let d2 = ex * ex + ey * ey;
+            sum += COHERENCE_EXP
+                .get(d2 as usize)
+                .copied()
+                .unwrap_or_else(|| (-d2 / (2.0 * 2.0)).exp());
             n += 1;
         }
     }
@@ -481,6 +529,16 @@ fn vote(pb: &Problem, nnf: &Nnf, t: &Tile, hist: &[[f32; 2]], w: usize, h: usize
             v
         }
     };
+    // The tile's layer distances and colour interleaved per pixel: one
+    // cache line per vote instead of one per grid.
+    let stride = layers + 3;
+    let mut tv = Vec::with_capacity(t.width() * t.height() * stride);
+    for y in 0..t.height() {
+        for x in 0..t.width() {
+            tv.extend(t.layers.iter().map(|l| l.sdf.get(x, y)));
+            tv.extend(t.colour.get(x, y));
+        }
+    }
     let rows: Vec<RowVote> = (0..h)
         .into_par_iter()
         .map(|y| {
@@ -513,9 +571,12 @@ fn vote(pb: &Problem, nnf: &Nnf, t: &Tile, hist: &[[f32; 2]], w: usize, h: usize
                         let sx = wrap(m.x as i64 + e.2 as i64, tw) as usize;
                         let sy = wrap(m.y as i64 + e.3 as i64, th) as usize;
                         let xu = x as usize;
+                        let base = (sy * tw as usize + sx) * stride;
+                        let Some(px) = tv.get(base..base + stride) else {
+                            continue;
+                        };
                         let mut wh0 = 1.0;
-                        for (l, layer) in t.layers.iter().enumerate() {
-                            let v = layer.sdf.get(sx, sy);
+                        for (l, &v) in px[..layers].iter().enumerate() {
                             let wh = hist[l][usize::from(v >= 0.0)];
                             if l == 0 {
                                 wh0 = wh;
@@ -524,9 +585,8 @@ fn vote(pb: &Problem, nnf: &Nnf, t: &Tile, hist: &[[f32; 2]], w: usize, h: usize
                             row.sdf_weight[xu * layers + l] += wh;
                         }
                         row.count[xu] += 1.0;
-                        let c = t.colour.get(sx, sy);
                         let wv = wc * wh0;
-                        for (acc, v) in row.colour[xu].iter_mut().zip(c) {
+                        for (acc, v) in row.colour[xu].iter_mut().zip(&px[layers..]) {
                             *acc += wv * v;
                         }
                         row.weight[xu] += wv;

@@ -14,22 +14,32 @@
 //! - [`tile`]: the exemplar's periodic SDF layers, colour and direction;
 //! - [`quilt`]: image-quilting initialization;
 //! - [`patchmatch`]: rotated-patch nearest neighbours;
+//! - [`shape`]: the Shape Hint descriptors of the tile's edge and the
+//!   region's outline;
 //! - [`levelset`]: narrow-band evolution of the SDF channels;
-//! - [`em`]: the multiresolution loop and voting.
+//! - [`em`]: the multiresolution loop and voting;
+//! - [`continuity`]: band ends, forks and gap regularity of a result (the
+//!   measure of the tears patch synthesis makes).
 //!
 //! Each layer's synthesized SDF is clipped to the region (`max(Φ, Φ_region)`,
 //! exact since both are distances), kept under the layers above it, traced
 //! with [`crate::trace::trace_sdf`] and written as one `<g>` per region.
 //!
-//! Not done: the Shape Hint term (Brushables Eq. 6) — the shipped tiles are
-//! seamless and have no boundary of their own to match; the colour warp by
-//! the level-set deformation field (§2, last paragraph), replaced by voting.
+//! Near the region's outline the M-step adds the Shape Hint of Brushables
+//! (Eq. 6, [`shape`]): the tile's edge is the line along its source
+//! direction through the middle of the ink, so a band lands on the outline
+//! and frames the region.
+//!
+//! Not done: the colour warp by the level-set deformation field (§2, last
+//! paragraph), replaced by voting.
 
+pub mod continuity;
 pub mod em;
 pub mod levelset;
 pub mod patchmatch;
 pub mod quilt;
 pub mod region;
+pub mod shape;
 pub mod tile;
 
 use crate::error::{Error, Result};

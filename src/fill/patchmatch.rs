@@ -17,6 +17,7 @@
 //! order), and random numbers are hashes of (seed, pass, position), so the
 //! result does not depend on the number of threads.
 
+use super::shape::{self, Histogram};
 use crate::pattern::rng;
 use crate::raster::Grid;
 use rayon::prelude::*;
@@ -151,7 +152,7 @@ fn round(v: f32) -> i64 {
 #[inline]
 pub fn angle_bin(beta: f32) -> usize {
     let t = beta / std::f32::consts::TAU * ANGLE_BINS as f32;
-    (t.round() as i64).rem_euclid(ANGLE_BINS as i64) as usize
+    round(t).rem_euclid(ANGLE_BINS as i64) as usize
 }
 
 /// What a search compares: the periodic source and its direction angles,
@@ -177,6 +178,21 @@ pub struct Problem<'a> {
     margin: usize,
     linear: Vec<Vec<isize>>,
     active: Option<&'a [bool]>,
+    shape: Option<ShapeTerm<'a>>,
+}
+
+/// The Shape Hint term of a search (Brushables Eq. 6): `weight · χ²`
+/// between the source pixel's and the target centre's descriptors, each
+/// in its own direction frame (so the pair is compared rotated by Eq. 5's
+/// angle); left out where the target descriptor is empty.
+#[derive(Clone, Copy, Debug)]
+pub struct ShapeTerm<'a> {
+    /// Descriptor of every tile pixel.
+    pub source: &'a Grid<Histogram>,
+    /// Descriptor of every target pixel.
+    pub target: &'a Grid<Histogram>,
+    /// Weight of χ² against the patch SSD.
+    pub weight: f32,
 }
 
 impl<'a> Problem<'a> {
@@ -219,6 +235,30 @@ impl<'a> Problem<'a> {
             margin,
             linear,
             active: None,
+            shape: None,
+        }
+    }
+
+    /// Adds the Shape Hint term to every distance.
+    pub fn with_shape(mut self, shape: ShapeTerm<'a>) -> Problem<'a> {
+        self.shape = Some(shape);
+        self
+    }
+
+    /// The Shape Hint cost of matching target `(qx, qy)` with tile pixel
+    /// `(px, py)` (0 without the term or away from the outline).
+    #[inline]
+    pub fn shape_cost(&self, qx: usize, qy: usize, px: usize, py: usize) -> f32 {
+        match &self.shape {
+            Some(s) => {
+                let t = s.target.get(qx, qy);
+                if shape::is_empty(&t) {
+                    0.0
+                } else {
+                    s.weight * shape::chi2(&s.source.get(px, py), &t)
+                }
+            }
+            None => 0.0,
         }
     }
 
@@ -295,7 +335,8 @@ impl<'a> Problem<'a> {
     }
 
     /// Distance between the gathered target patch of `(qx, qy)` and tile
-    /// pixel `(px, py)`; stops early once over `bound`.
+    /// pixel `(px, py)`, plus the Shape Hint cost; stops early once over
+    /// `bound`.
     pub fn distance(
         &self,
         tp: &[f32],
@@ -308,7 +349,10 @@ impl<'a> Problem<'a> {
         let d = self.source.depth;
         let offsets = &self.linear[self.bin(px, py, qx, qy)];
         let base = (((py + self.margin) * self.padded_width + px + self.margin) * d) as isize;
-        let mut sum = 0.0f32;
+        let mut sum = self.shape_cost(qx, qy, px, py);
+        if sum > bound {
+            return sum;
+        }
         for (t, &off) in tp.chunks_exact(d).zip(offsets) {
             let i = (base + off) as usize;
             let sp = &self.padded[i..i + d];

@@ -87,8 +87,10 @@ pub fn quilt(
             let overlap_err = |sx: usize, sy: usize| -> f32 {
                 let be = beta(sx, sy);
                 let mut e = 0.0f32;
+                // Earlier blocks reach only the left and top overlaps.
                 for y in 0..bh {
-                    for x in 0..bw {
+                    let xs = if y < ov { bw } else { ov.min(bw) };
+                    for x in 0..xs {
                         if !filled.get(bx + x, by + y) {
                             continue;
                         }

@@ -44,6 +44,83 @@ pub struct Tile {
     pub direction: DirectionGrid,
     /// Tile user units per tile pixel at this resolution.
     pub units_per_px: f64,
+    /// Where the pattern meets a border (Shape Hint), with a constant
+    /// source direction.
+    pub edge: Option<EdgeLine>,
+}
+
+/// A straight line on the tile (a torus) along the source direction: the
+/// tile's stand-in for an exemplar's outline in the Shape Hint
+/// ([`super::shape`]). It runs through the middle of the ink (the deepest
+/// mean of the bottom layer's SDF along it), so the band lying on it is
+/// what the synthesis puts on a region's outline.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EdgeLine {
+    /// A point of the line, tile pixels.
+    pub origin: [f64; 2],
+    /// Unit direction, pixel axes.
+    pub dir: [f64; 2],
+}
+
+impl EdgeLine {
+    /// The line with the deepest ink of `sdf` (bottom layer, periodic)
+    /// among the parallels to `dir` half a pixel apart; `None` when the
+    /// line's copies would cover more than a quarter of the tile (a
+    /// direction at an odd slope winds densely around the torus).
+    pub fn deepest(sdf: &Grid<f32>, dir: [f64; 2]) -> Option<EdgeLine> {
+        let l = dir[0].hypot(dir[1]);
+        if l.is_nan() || l <= 1e-9 {
+            return None;
+        }
+        let d = [dir[0] / l, dir[1] / l];
+        let n = [-d[1], d[0]];
+        let (w, h) = (sdf.width(), sdf.height());
+        let mut best: Option<(f64, EdgeLine)> = None;
+        for i in 0..2 * w.max(h) {
+            let t = i as f64 * 0.5;
+            let line = EdgeLine {
+                origin: [t * n[0], t * n[1]],
+                dir: d,
+            };
+            let mut sum = 0.0;
+            let mut count = 0usize;
+            line.walk(w, h, 0.5, |x, y| {
+                sum -= sdf.get(x, y) as f64;
+                count += 1;
+            });
+            let score = sum / count.max(1) as f64;
+            if best.is_none_or(|(b, _)| score > b) {
+                best = Some((score, line));
+            }
+        }
+        let line = best?.1;
+        let covered = line.raster(w, h).data().iter().filter(|&&e| e).count();
+        (4 * covered <= w * h).then_some(line)
+    }
+
+    /// Calls `f` with the pixel under each point of the line `step` px
+    /// apart over four times the tile's larger side (a line at a simple
+    /// slope closes on the torus within that), wrapped to the tile.
+    fn walk(&self, w: usize, h: usize, step: f64, mut f: impl FnMut(usize, usize)) {
+        let n = (4 * w.max(h)) as f64 / step;
+        for k in 0..n as usize {
+            let s = k as f64 * step;
+            let (x, y) = (
+                self.origin[0] + s * self.dir[0],
+                self.origin[1] + s * self.dir[1],
+            );
+            let px = (x.floor() as i64).rem_euclid(w as i64) as usize;
+            let py = (y.floor() as i64).rem_euclid(h as i64) as usize;
+            f(px, py);
+        }
+    }
+
+    /// The line's pixels on a `w`×`h` tile.
+    pub fn raster(&self, w: usize, h: usize) -> Grid<bool> {
+        let mut g = Grid::new(w, h, false);
+        self.walk(w, h, 0.25, |x, y| g.set(x, y, true));
+        g
+    }
 }
 
 impl Tile {
@@ -97,6 +174,10 @@ impl Tile {
     pub fn assemble(layers: Vec<TileLayer>, dir: SourceDirection, units_per_px: f64) -> Tile {
         let (w, h) = (layers[0].sdf.width(), layers[0].sdf.height());
         let colour = composite(&layers, w, h);
+        let edge = match dir {
+            SourceDirection::Constant(d) => EdgeLine::deepest(&layers[0].sdf, d),
+            SourceDirection::Etf => None,
+        };
         let direction = match dir {
             SourceDirection::Constant(d) => crate::field::diffusion::constant_field(w, h, d),
             SourceDirection::Etf => {
@@ -114,6 +195,7 @@ impl Tile {
             colour,
             direction,
             units_per_px,
+            edge,
         }
     }
 
@@ -173,6 +255,10 @@ impl Tile {
             colour,
             direction,
             units_per_px: self.units_per_px * 2.0,
+            edge: self.edge.map(|e| EdgeLine {
+                origin: [0.5 * e.origin[0], 0.5 * e.origin[1]],
+                dir: e.dir,
+            }),
         }
     }
 }
@@ -231,6 +317,39 @@ mod tests {
             }
         }
         assert!((t.ink_fraction(0) - 0.5).abs() < 0.01);
+    }
+
+    #[test]
+    fn the_edge_line_runs_down_the_middle_of_a_stripe() {
+        let sdf = periodic_sdf(&Grid::from_fn(32, 32, |x, _| {
+            let u = (x % 8) as f32 + 0.5;
+            (u - 4.0).max(-u)
+        }));
+        let line = EdgeLine::deepest(&sdf, [0.0, 2.0]).unwrap();
+        assert_eq!(line.dir, [0.0, 1.0]);
+        let r = line.raster(32, 32);
+        let px: Vec<(usize, usize)> = (0..32 * 32)
+            .map(|i| (i % 32, i / 32))
+            .filter(|&(x, y)| r.get(x, y))
+            .collect();
+        // One whole column, in a stripe's middle.
+        assert_eq!(px.len(), 32);
+        assert!(px
+            .iter()
+            .all(|&(x, y)| sdf.get(x, y) < -1.0 && x == px[0].0));
+        // It halves with the tile.
+        let layers = vec![TileLayer {
+            color: Color::BLACK,
+            sdf,
+        }];
+        let t = Tile::assemble(layers, SourceDirection::Constant([0.0, 1.0]), 1.0);
+        let h = t.half();
+        let e = h.edge.unwrap();
+        let hr = e.raster(16, 16);
+        assert!((0..16).all(|y| (0..16).any(|x| hr.get(x, y) && h.layers[0].sdf.get(x, y) < 0.0)));
+        // An ETF source has no edge line.
+        let etf = Tile::assemble(t.layers.clone(), SourceDirection::Etf, 1.0);
+        assert!(etf.edge.is_none());
     }
 
     #[test]
