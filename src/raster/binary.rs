@@ -539,12 +539,7 @@ fn relax(l: &mut SmoothLoop) {
     if n < 5 {
         return;
     }
-    let mut is_corner = vec![false; n];
-    for &c in &l.corners {
-        if c < n {
-            is_corner[c] = true;
-        }
-    }
+    let is_corner = corner_mask(l);
     let pass = |pts: &[Point], factor: f64| -> Vec<Point> {
         // gap[k]: the length of the segment from vertex k to k + 1.
         let gap: Vec<f64> = (0..n)
@@ -562,11 +557,7 @@ fn relax(l: &mut SmoothLoop) {
                     let mut j = i;
                     let mut d = 0.0;
                     loop {
-                        let k = if forward {
-                            (j + 1) % n
-                        } else {
-                            (j + n - 1) % n
-                        };
+                        let k = adjacent(j, forward, n);
                         d += if forward { gap[j] } else { gap[k] };
                         if d >= RELAX_RADIUS || k == i {
                             break;
@@ -593,6 +584,27 @@ fn relax(l: &mut SmoothLoop) {
     l.points = pass(&a, -1.0 / 0.9);
 }
 
+/// The neighbour of vertex `j` on a closed loop of `n` vertices, ahead or
+/// behind.
+fn adjacent(j: usize, forward: bool, n: usize) -> usize {
+    if forward {
+        (j + 1) % n
+    } else {
+        (j + n - 1) % n
+    }
+}
+
+/// Per point of the loop: whether it is a corner.
+fn corner_mask(l: &SmoothLoop) -> Vec<bool> {
+    let mut v = vec![false; l.points.len()];
+    for &c in &l.corners {
+        if let Some(x) = v.get_mut(c) {
+            *x = true;
+        }
+    }
+    v
+}
+
 /// How far (px) to either side of a point its tangent chord reaches.
 const TANGENT_REACH: f64 = 1.5;
 
@@ -613,26 +625,14 @@ fn smooth_tangents(l: &mut SmoothLoop) {
         cum.push(s);
     }
     let total = s;
-    let is_corner = {
-        let mut v = vec![false; n];
-        for &c in &l.corners {
-            if c < n {
-                v[c] = true;
-            }
-        }
-        v
-    };
+    let is_corner = corner_mask(l);
     let reach = TANGENT_REACH.min(total / 4.0);
     // Walks from i along the loop (dir = ±1) up to `reach` px or a corner.
     let walk = |i: usize, forward: bool| -> Point {
         let mut j = i;
         let mut d = 0.0;
         loop {
-            let k = if forward {
-                (j + 1) % n
-            } else {
-                (j + n - 1) % n
-            };
+            let k = adjacent(j, forward, n);
             let step = (l.points[k] - l.points[j]).hypot();
             if d + step >= reach {
                 let f = if step > 0.0 { (reach - d) / step } else { 0.0 };

@@ -17,7 +17,7 @@ use crate::error::{Error, Result};
 use crate::raster::binary::SmoothLoop;
 use crate::raster::input::{self, Ink, InputOptions, Traceable};
 use crate::raster::Sdf;
-use crate::svg_out::{decimals_for, Document, FillRule, Group, Shape};
+use crate::svg_out::{decimals_for, Color, Document, FillRule, Group, Shape};
 use contour::{contains, Contour};
 use kurbo::{BezPath, Point, Rect};
 use rayon::prelude::*;
@@ -193,22 +193,25 @@ pub fn trace_ink(ink: &Ink, opts: &TraceOptions) -> Result<Document> {
         decimals_for(opts.tolerance / px_per_unit),
     );
     for (i, layer) in ink.layers.iter().enumerate() {
-        let paths = trace_sdf(&layer.sdf, opts);
-        if paths.is_empty() {
-            continue;
-        }
-        doc.groups.push(Group {
-            id: format!("layer-{}", i + 1),
-            shapes: paths
-                .into_iter()
-                .map(|p| Shape {
-                    fill_rule: FillRule::NonZero,
-                    ..Shape::filled(p, layer.color)
-                })
-                .collect(),
-        });
+        doc.groups
+            .extend(layer_group(i, trace_sdf(&layer.sdf, opts), layer.color));
     }
     Ok(doc)
+}
+
+/// The `<g id="layer-N">` of layer `i`'s traced paths (non-zero fill, so
+/// holes stay open), or nothing when it has none.
+fn layer_group(i: usize, paths: Vec<BezPath>, color: Color) -> Option<Group> {
+    (!paths.is_empty()).then(|| Group {
+        id: format!("layer-{}", i + 1),
+        shapes: paths
+            .into_iter()
+            .map(|p| Shape {
+                fill_rule: FillRule::NonZero,
+                ..Shape::filled(p, color)
+            })
+            .collect(),
+    })
 }
 
 /// Reads `path` (raster or SVG) and traces it: the library side of
@@ -220,19 +223,8 @@ pub fn trace_file(path: &Path, input: &InputOptions, opts: &TraceOptions) -> Res
         Traceable::Field(ink) => trace_ink(&ink, opts),
         Traceable::Outline(o) => {
             let mut doc = Document::new(o.width, o.height, decimals_for(opts.tolerance));
-            let paths = trace_outline(&o.loops, opts);
-            if !paths.is_empty() {
-                doc.groups.push(Group {
-                    id: "layer-1".into(),
-                    shapes: paths
-                        .into_iter()
-                        .map(|p| Shape {
-                            fill_rule: FillRule::NonZero,
-                            ..Shape::filled(p, o.color)
-                        })
-                        .collect(),
-                });
-            }
+            doc.groups
+                .extend(layer_group(0, trace_outline(&o.loops, opts), o.color));
             Ok(doc)
         }
     }
