@@ -605,6 +605,25 @@ fn corner_mask(l: &SmoothLoop) -> Vec<bool> {
     v
 }
 
+/// A closed polygon that follows an outline closely (an anti-aliased
+/// bitmap's sub-pixel outline) as a [`SmoothLoop`]: corners where it turns
+/// sharply within a pixel or so ([`crate::trace::fit::corners`]), chord
+/// tangents elsewhere.
+pub fn polygon_loop(points: Vec<Point>) -> SmoothLoop {
+    let corners = crate::trace::fit::corners(&points);
+    let n = points.len();
+    let tangents = (0..n)
+        .map(|i| unit(points[(i + 1) % n] - points[i]))
+        .collect();
+    let mut l = SmoothLoop {
+        points,
+        tangents,
+        corners,
+    };
+    smooth_tangents(&mut l);
+    l
+}
+
 /// How far (px) to either side of a point its tangent chord reaches.
 const TANGENT_REACH: f64 = 1.5;
 

@@ -18,6 +18,7 @@ use crate::error::{Error, Result};
 use crate::io;
 use crate::svg_out::Color;
 use kurbo::{Affine, BezPath, Line, PathEl, Point};
+use rayon::prelude::*;
 use resvg::tiny_skia;
 use resvg::usvg;
 use std::path::Path;
@@ -149,6 +150,20 @@ pub fn load_traceable(path: &Path, opts: &InputOptions) -> Result<Traceable> {
             color,
             loops: super::binary::smooth_loops(&cov),
         })),
+        // One anti-aliased layer: its sub-pixel outline, fitted directly.
+        RasterCoverage::Layers { w, h, layers } if layers.len() == 1 && !opts.layers => {
+            let (color, cov) = &layers[0];
+            Ok(Traceable::Outline(OutlineInk {
+                width: w as f64,
+                height: h as f64,
+                color: *color,
+                loops: super::sdf::subpixel_outline(cov)
+                    .into_par_iter()
+                    .filter(|p| p.len() >= 3)
+                    .map(super::binary::polygon_loop)
+                    .collect(),
+            }))
+        }
         other => Ok(Traceable::Field(other.into_ink())),
     }
 }
