@@ -303,15 +303,17 @@ fn emd(a: &[f64], b: &[f64]) -> f64 {
 fn flourish_keeps_the_exemplars_structure_where_the_art_brush_drifts() {
     for st in ["vine", "doodle", "scroll"] {
         let style = style(st);
-        // The exemplars' own figures, at the finest level.
+        // The exemplars' own figures, at the finest level, per stroke
+        // width: the style's exemplar width, the same finest-px width the
+        // canvas maps each query's stroke width to, so exemplars and
+        // outputs are counted per the same length of ornament.
+        let ew = flourish::brush::pipeline::exemplar_width(style).unwrap();
         let mut ex_density = 0.0;
         let mut ex_thick = Vec::new();
         for e in &style.exemplars {
             let lv = e.finest().unwrap();
             let mask = lv.ink.ink.map(|v| v < 0.0);
-            let widths = e.ribs.widths();
-            let wmean = widths.iter().sum::<f64>() / widths.len() as f64;
-            let (dens, th) = structure(&mask, wmean, e.spine_length());
+            let (dens, th) = structure(&mask, ew, e.spine_length());
             ex_density += dens / style.exemplars.len() as f64;
             ex_thick.extend(th);
         }
@@ -346,19 +348,21 @@ fn flourish_keeps_the_exemplars_structure_where_the_art_brush_drifts() {
             rel(fl.0),
             rel(ab.0)
         );
-        // The stretched baseline's structure density drifts far from the
-        // exemplars'; flourish keeps the structure at least as dense
-        // (it over-counts: broken lines add ends, see the README), and its
-        // line thicknesses stay the exemplars' where the baseline's drift.
+        // Flourish keeps the exemplars' structure density (pieces and line
+        // ends per width: spurs, breaks and debris raise it, a stretched
+        // copy lowers it) within 30 %, and closer than the stretched
+        // baseline; its line thicknesses stay the exemplars' where the
+        // baseline's drift.
         assert!(
-            rel(ab.0) > 0.3,
-            "{st}: art brush density drift {}",
-            rel(ab.0)
-        );
-        assert!(
-            fl.0 >= 0.75 * ex_density,
+            rel(fl.0) <= 0.3,
             "{st}: flourish density {} vs exemplars {ex_density}",
             fl.0
+        );
+        assert!(
+            rel(fl.0) < rel(ab.0),
+            "{st}: flourish density drift {} vs art brush {}",
+            rel(fl.0),
+            rel(ab.0)
         );
         assert!(
             fl.1 < 0.5 * ab.1,

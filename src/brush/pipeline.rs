@@ -296,8 +296,13 @@ fn orient_of(
 }
 
 /// Pixels (at the start level) by which the seam regions, where the ANN
-/// search runs, extend beyond the overlaps of matched segments.
-pub const SEAM_MARGIN: isize = 3;
+/// search runs, extend on either side of the graph-cut seams: the radius
+/// of a 5×5 neighbourhood, so exactly the pixels whose neighbourhood
+/// straddles a cut (the "red curves" of decobrush.txt Fig. 6c, §5.4.2).
+/// Elsewhere every pixel's neighbourhood lies in one warped segment and
+/// only the coherent candidates are searched: ANN picks there seed
+/// pixel-sized patches that break lines.
+pub const SEAM_MARGIN: isize = 2;
 
 /// A coordinate field from several warped exemplar segments: owners,
 /// orientation and seam mask.
@@ -331,8 +336,12 @@ fn compose(
                     orient.set(x, y, o);
                 }
             }
-            let covering = fields.iter().filter(|(_, g)| g.get(x, y).is_some()).count();
-            if covering > 1 {
+            let me = owner.get(x, y);
+            let cut = [(1isize, 0isize), (0, 1)].iter().any(|&(dx, dy)| {
+                let o = owner.get_or(x as isize + dx, y as isize + dy, None);
+                o.is_some() && o != me
+            });
+            if cut {
                 for dy in -SEAM_MARGIN..=SEAM_MARGIN {
                     for dx in -SEAM_MARGIN..=SEAM_MARGIN {
                         let (nx, ny) = (x as isize + dx, y as isize + dy);
