@@ -147,7 +147,7 @@ struct BrushArgs {
     #[arg(long, value_name = "REFINE.svg")]
     refine: Option<PathBuf>,
     /// Correction iterations per synthesis level (0: graph cut upsampled only).
-    #[arg(long, default_value_t = 2, value_name = "N")]
+    #[arg(long, default_value_t = 1, value_name = "N")]
     iterations: usize,
 }
 

@@ -4,8 +4,8 @@
 //! order with the layers' colours, bottom layer first.
 
 use super::pipeline::{as_branch, brush_query, starts_on, BrushOptions, QueryResult};
-use super::synth::{self, Coord, Field};
 use super::query::{self, QuerySpine};
+use super::synth::{self, Coord, Field};
 use crate::error::{Error, Result};
 use crate::raster::{Grid, Sdf};
 use crate::sketch::Sketch;
@@ -123,6 +123,11 @@ pub fn extend_field(style: &BrushStyle, field: &Field, rings: usize) -> Field {
     f
 }
 
+/// Radius of the blended read, px.
+const BLEND: isize = 2;
+/// Binomial weights of the blended read.
+const BINOMIAL: [f32; 5] = [1.0, 4.0, 6.0, 4.0, 1.0];
+
 /// The 8-neighbour offsets in scan order.
 const NEIGHBOURS: [(isize, isize); 8] = [
     (-1, -1),
@@ -188,21 +193,19 @@ pub fn blended_sdf(style: &BrushStyle, field: &Field, color: Option<Color>) -> G
                         return PAPER;
                     }
                     let (mut acc, mut wsum) = (0.0f32, 0.0f32);
-                    for dy in -1isize..=1 {
-                        for dx in -1isize..=1 {
+                    for dy in -BLEND..=BLEND {
+                        for dx in -BLEND..=BLEND {
                             let (nx, ny) = (x as isize + dx, y as isize + dy);
                             let Some(c) = g.get_or(nx, ny, None) else {
                                 continue;
                             };
-                            let Some(j) = jac
-                                .get(ny as usize * w + nx as usize)
-                                .copied()
-                                .flatten()
+                            let Some(j) = jac.get(ny as usize * w + nx as usize).copied().flatten()
                             else {
                                 continue;
                             };
                             let d = synth::apply(j, [-dx as f32, -dy as f32]);
-                            let wt = ((2 - dx.abs()) * (2 - dy.abs())) as f32;
+                            let wt =
+                                BINOMIAL[(dx + BLEND) as usize] * BINOMIAL[(dy + BLEND) as usize];
                             let p = Coord {
                                 exemplar: c.exemplar,
                                 x: c.x + d[0],
@@ -287,9 +290,12 @@ pub fn smallest_exemplar_component(style: &BrushStyle) -> usize {
 }
 
 /// The final per-layer canvas SDFs of a query, bottom layer first, with
-/// their colours: smoothed, and with debris removed — ink components
-/// smaller than the exemplars' smallest, except pieces of at least an
-/// eighth of that on the spine's core band.
+/// their colours: each layer read through the continued field with the
+/// blended read ([`blended_sdf`]); then a last, documented cleanup: ink
+/// components smaller than the exemplars' smallest piece
+/// ([`smallest_exemplar_component`], the threshold taken from the style,
+/// not a constant) are synthesis debris and are cleared; the query's
+/// largest piece is its body and always stays.
 pub fn final_layers(style: &BrushStyle, r: &QueryResult) -> Vec<(Color, Grid<f32>)> {
     let field = extend_field(style, &r.field, border_rings(r));
     let mut layers: Vec<(Color, Grid<f32>)> = palette(style)
@@ -301,19 +307,13 @@ pub fn final_layers(style: &BrushStyle, r: &QueryResult) -> Vec<(Color, Grid<f32
     };
     let (w, h) = (first.width(), first.height());
     let ink = Grid::from_fn(w, h, |x, y| layers.iter().any(|(_, g)| g.get(x, y) < 0.0));
-    let min = smallest_exemplar_component(style);
-    // The spine's core band (a quarter width): a piece there of at least
-    // an eighth of the smallest exemplar piece is part of the ornament's
-    // body, broken off or not, and stays.
-    let to_px = r.canvas.to_pixel(1.0);
-    let spine: Vec<kurbo::Point> = r.spine.samples.iter().map(|s| to_px * s.pos).collect();
-    let core = 0.25 * r.spine.width * r.canvas.px_per_unit;
-    let on_core = |i: usize| {
-        let p = kurbo::Point::new((i % w) as f64 + 0.5, (i / w) as f64 + 0.5);
-        spine.iter().any(|q| q.distance(p) <= core)
-    };
-    for comp in components(&ink) {
-        if comp.len() >= min || (8 * comp.len() >= min && comp.iter().any(|&i| on_core(i))) {
+    let comps = components(&ink);
+    // A query shorter than every exemplar can have a body smaller than
+    // the exemplars' smallest piece: the largest piece always stays.
+    let largest = comps.iter().map(Vec::len).max().unwrap_or(0);
+    let min = smallest_exemplar_component(style).min(largest);
+    for comp in comps {
+        if comp.len() >= min {
             continue;
         }
         for (_, g) in &mut layers {
