@@ -168,10 +168,10 @@ fn correction_lowers_the_synthesis_energy() {
             },
             ..BrushOptions::default()
         };
-        let e0 = brush_query(style, q, &cut_only).unwrap().energy;
+        let e0 = brush_query(style, q, &cut_only).unwrap().energy(style);
         let e1 = brush_query(style, q, &BrushOptions::default())
             .unwrap()
-            .energy;
+            .energy(style);
         eprintln!("{s}/{st}: energy after graph cut {e0:.4}, after synthesis {e1:.4}");
         assert!(e1 < e0, "{s}/{st}: {e1} vs {e0}");
     }

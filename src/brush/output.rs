@@ -444,7 +444,6 @@ fn refine_all(
             }
         }
         if let Some(f) = crate::brush::synth::refine(style, &r.levels, &target, &mask, &sopts) {
-            r.energy = crate::brush::synth::energy(style, &f);
             r.field = f;
         }
         out.push(r);

@@ -88,14 +88,20 @@ pub struct QueryResult {
     pub canvas: Canvas,
     /// The synthesized coordinate field at the finest level.
     pub field: Field,
-    /// The synthesis energy of the final field ([`synth::energy`]).
-    pub energy: f64,
     /// Matched segments (exemplar index, query sample range); empty for the
     /// art-brush baseline.
     pub segments: Vec<(usize, std::ops::Range<usize>)>,
     /// The corrected field of every synthesis level, coarse to fine (for
     /// refinement, §5.5); empty for the baseline.
     pub levels: Vec<Field>,
+}
+
+impl QueryResult {
+    /// The synthesis energy of the final field ([`synth::energy`]):
+    /// computed on demand, it costs about one correction pass.
+    pub fn energy(&self, style: &BrushStyle) -> f64 {
+        synth::energy(style, &self.field)
+    }
 }
 
 /// Narrowest mean stroke width (px) at which a level's 5×5 neighbourhoods
@@ -604,7 +610,6 @@ fn run_query(
         return Ok(QueryResult {
             spine: q.clone(),
             canvas,
-            energy: synth::energy(style, &init),
             field: init,
             segments,
             levels: Vec::new(),
@@ -619,12 +624,10 @@ fn run_query(
         .last()
         .cloned()
         .ok_or_else(|| Error::degenerate("brush", "synthesis produced no level"))?;
-    let energy = synth::energy(style, &field);
     Ok(QueryResult {
         spine: q.clone(),
         canvas,
         field,
-        energy,
         segments,
         levels,
     })
@@ -660,12 +663,10 @@ fn art_brush(
         fields[0].1.get(x, y).map(|_| 0)
     });
     let field = compose(style, finest, &fields, &owner);
-    let energy = synth::energy(style, &field);
     Ok(QueryResult {
         spine: q.clone(),
         canvas,
         field,
-        energy,
         segments: Vec::new(),
         levels: Vec::new(),
     })

@@ -258,11 +258,16 @@ const LAYER_OFFSETS: [[f32; 2]; 9] = [
 /// `None` on paper or outside the exemplar.
 pub fn layer_at(style: &BrushStyle, level: usize, c: Coord) -> Option<Color> {
     let lv = level_of(style, c.exemplar, level)?;
+    if !(c.x >= 0.0 && c.y >= 0.0) {
+        return None;
+    }
+    // The pixel holding the coordinate: a label needs no interpolation.
+    let (x, y) = (c.x as isize, c.y as isize);
     lv.ink
         .layers
         .iter()
         .rev()
-        .find(|l| l.sdf.sample(c.x as f64, c.y as f64) < 0.0)
+        .find(|l| l.sdf.get_or(x, y, 1.0) < 0.0)
         .map(|l| l.color)
 }
 
