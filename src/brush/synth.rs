@@ -9,20 +9,26 @@
 //!   [`crate::synth::neighbourhood`] with its up axis along the query
 //!   orientation ω^q. Candidates are the pixel's own μ and the eight
 //!   coherent ones: neighbour n's coordinate continued to p,
-//!   `μ(n) + J_e^T J_q (p − n)`. The nearest by L² wins; near-equal ones
+//!   `μ(n) + J(n) (p − n)` ([`jacobian`]). A candidate's distance is the
+//!   SDF L² plus [`LAYER_WEIGHT`] per disagreeing top layer on the 3×3
+//!   (the SDF sees all ink as one), multiplied by
+//!   `1 + κ (8 − a) / 8` where `a` of the 8 neighbours hold its
+//!   continuation ("strong coherence"). The nearest wins; near-equal ones
 //!   (within a relative tie tolerance) are chosen by a hash of (seed,
-//!   level, pass, pixel). In seam regions the style's k-d tree also gives
-//!   an approximate nearest neighbour over all exemplars, taken when the
-//!   best coherent distance is 5× or more its distance (the paper's rule).
+//!   level, pass, pixel). In seam regions (around the graph cuts) the
+//!   style's k-d tree also gives an approximate nearest neighbour over all
+//!   exemplars, taken when the best coherent distance is 5× or more its
+//!   distance (the paper's rule).
 //! * **Sub-passes.** Pixels are corrected on a 2×2 lattice, four sub-passes
 //!   per iteration; each sub-pass reads only the field left by the previous
 //!   one and writes only its own lattice pixels, so the parallel loop gives
 //!   the same field at any thread count.
 //! * **Upsampling** (§5.4.3). Child `p + Δ` (Δ = (±½, ±½) fine px) of a
-//!   parent p inherits `2 μ(p) + J_e^T J_q Δ`, where `J_q`, `J_e` are the
+//!   parent p inherits `2 μ(p) + J Δ`. The paper's `J = J_e^T J_q` (the
 //!   reflection matrices `[[ω_x, ω_y], [ω_y, −ω_x]]` of the query and
-//!   exemplar orientations: `J_e^T J_q` is the rotation taking the query's
-//!   stroke frame onto the exemplar's.
+//!   exemplar orientations, a rotation) is used where the parent has no
+//!   coherent neighbour; inside a patch `J` is the field's measured
+//!   Jacobian, so a warped segment is continued as the warp it is.
 
 use crate::pattern::rng;
 use crate::raster::Grid;
