@@ -549,20 +549,9 @@ fn run_query(
         ..opts.matching.clone()
     };
     let qf = SpineFeatures::from_query(q);
-    // The beam search can lose every complete state on short or unusual
-    // queries; the exhaustive candidate set then decides.
-    let m = match match_query(&qf, &feats, &mopts) {
-        Ok(m) => m,
-        Err(_) => match_query(
-            &qf,
-            &feats,
-            &MatchOptions {
-                candidates: usize::MAX,
-                beam: usize::MAX,
-                ..mopts
-            },
-        )?,
-    };
+    // The beam keeps the best state of every run length, so a complete
+    // segmentation survives to the last sample (no exhaustive retry).
+    let m = match_query(&qf, &feats, &mopts)?;
     let start = opts
         .start_level
         .unwrap_or_else(|| start_level(style, ew))
