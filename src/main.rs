@@ -137,7 +137,8 @@ struct BrushArgs {
     cache: Option<PathBuf>,
     #[command(flatten)]
     out: Outputs,
-    /// Write N alternatives OUT-1.svg … OUT-N.svg (seeds seed … seed+N−1).
+    /// Write N alternatives OUT-1.svg … OUT-N.svg, or NAME-v1.svg … NAME-vN.svg
+    /// with --out-dir (seeds seed … seed+N−1).
     #[arg(long, default_value_t = 1, value_name = "N")]
     variations: u32,
     /// Draw the art-brush baseline instead (one exemplar stretched along the path).
@@ -147,7 +148,7 @@ struct BrushArgs {
     #[arg(long, value_name = "REFINE.svg")]
     refine: Option<PathBuf>,
     /// Correction iterations per synthesis level (0: graph cut upsampled only).
-    #[arg(long, default_value_t = 2, value_name = "N")]
+    #[arg(long, default_value_t = 1, value_name = "N")]
     iterations: usize,
 }
 
@@ -390,10 +391,11 @@ fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
         return Err(Failure::Usage("--variations must be in 1..=100".into()));
     }
     if args.variations > 1
+        && args.out.out_dir.is_none()
         && (args.out.output.is_none() || args.out.output.as_deref() == Some(Path::new("-")))
     {
         return Err(Failure::Usage(
-            "--variations needs -o OUT.svg (a file)".into(),
+            "--variations needs -o OUT.svg (a file) or --out-dir DIR".into(),
         ));
     }
     let styles = args
@@ -438,7 +440,7 @@ fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
                         q.segments.len(),
                         q.canvas.width,
                         q.canvas.height,
-                        q.energy
+                        q.energy(&style)
                     );
                 }
             }
@@ -463,13 +465,14 @@ fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
                 suffixed(p)
             }
         });
-        run_jobs(
+        run_variant(
             &args.sketches,
             output.as_deref(),
             args.out.out_dir.as_deref(),
             preview.as_deref(),
             quiet,
             &job,
+            (args.variations > 1).then_some(k + 1),
         )?;
     }
     Ok(())
@@ -483,6 +486,22 @@ fn run_jobs(
     quiet: bool,
     job: &(dyn Fn(&Path) -> Result<String, Error> + Sync),
 ) -> Result<(), Failure> {
+    run_variant(inputs, output, out_dir, preview, quiet, job, None)
+}
+
+/// [`run_jobs`] for one variation `k` (1-based) of several: with
+/// `--out-dir` the files are named `NAME-vK.svg` / `NAME-vK.png`.
+fn run_variant(
+    inputs: &[PathBuf],
+    output: Option<&Path>,
+    out_dir: Option<&Path>,
+    preview: Option<&Path>,
+    quiet: bool,
+    job: &(dyn Fn(&Path) -> Result<String, Error> + Sync),
+    variant: Option<u32>,
+) -> Result<(), Failure> {
+    let svg_name = |p: &Path| named(p, variant, "svg");
+    let png_name = |p: &Path| named(p, variant, "png");
     match (output, out_dir) {
         (Some(out), None) => {
             if inputs.len() != 1 {
@@ -578,12 +597,14 @@ fn write_outputs(out: &Path, svg: &str, preview: Option<&Path>) -> Result<(), Er
     }
 }
 
-fn png_name(inp: &Path) -> PathBuf {
-    Path::new(inp.file_stem().unwrap_or_default()).with_extension("png")
-}
-
-fn svg_name(inp: &Path) -> PathBuf {
-    Path::new(inp.file_stem().unwrap_or_default()).with_extension("svg")
+/// The output file name of an input in an `--out-dir`: its stem, `-vK`
+/// for variation K, and the extension.
+fn named(inp: &Path, variant: Option<u32>, ext: &str) -> PathBuf {
+    let mut stem = inp.file_stem().unwrap_or_default().to_os_string();
+    if let Some(k) = variant {
+        stem.push(format!("-v{k}"));
+    }
+    Path::new(&stem).with_extension(ext)
 }
 
 fn check_not_input(input: &Path, output: &Path) -> Result<(), Failure> {

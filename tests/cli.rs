@@ -1308,3 +1308,59 @@ fn zero_length_path_is_skipped_with_a_warning() {
     assert_eq!(code(&o), Some(0));
     assert!(stderr(&o).is_empty(), "{}", stderr(&o));
 }
+
+// ---------------------------------------------------------------------------
+// brush
+
+/// `--variations N --out-dir DIR` writes `NAME-v1.svg … NAME-vN.svg` (and
+/// previews `NAME-vK.png`) for every input, each variation with its own
+/// seed; `--variations` with neither `-o` nor `--out-dir` is a usage error.
+#[test]
+fn brush_variations_with_out_dir_name_each_variation() {
+    let dir = tempdir();
+    let (out, png) = (dir.path().join("out"), dir.path().join("png"));
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::create_dir_all(&png).unwrap();
+    let sketch = |name: &str, d: &str| {
+        let p = dir.path().join(format!("{name}.svg"));
+        std::fs::write(
+            &p,
+            format!(
+                r##"<svg xmlns="http://www.w3.org/2000/svg" width="200" height="100" viewBox="0 0 200 100"><path id="{name}" d="{d}" fill="none" stroke="#000" stroke-width="14"/></svg>"##
+            ),
+        )
+        .unwrap();
+        p
+    };
+    let a = sketch("wave", "M20 60 C 60 10, 120 100, 180 40");
+    let b = sketch("line", "M20 50 L180 50");
+    let cache = std::env::temp_dir().join("flourish-test-cache");
+    let o = flourish(&[
+        "brush",
+        "--style",
+        "doodle",
+        "--cache",
+        s(&cache),
+        s(&a),
+        s(&b),
+        "--out-dir",
+        s(&out),
+        "--preview",
+        s(&png),
+        "--variations",
+        "2",
+        "--quiet",
+    ]);
+    assert_eq!(code(&o), Some(0), "{}", stderr(&o));
+    for name in ["wave", "line"] {
+        let v1 = std::fs::read_to_string(out.join(format!("{name}-v1.svg"))).unwrap();
+        let v2 = std::fs::read_to_string(out.join(format!("{name}-v2.svg"))).unwrap();
+        assert!(v1.contains(&format!("<g id=\"{name}\"")), "{v1}");
+        assert_ne!(v1, v2, "{name}: the two variations differ");
+        assert!(png.join(format!("{name}-v1.png")).is_file());
+        assert!(png.join(format!("{name}-v2.png")).is_file());
+        assert!(!out.join(format!("{name}.svg")).exists());
+    }
+    let o = flourish(&["brush", "--style", "doodle", s(&a), "--variations", "2"]);
+    assert_usage(&o, "--variations");
+}

@@ -21,7 +21,10 @@
 //! candidate, run length — exact up to the maximum segment length, or
 //! capped at the minimum when there is no maximum). Candidates
 //! per query sample are the `candidates` best exemplar samples by data term
-//! plus the continuations of the `beam` best states of the previous sample,
+//! plus the continuations of the `beam` best states of the previous sample
+//! and of the best state of every run length (so a segment just begun
+//! survives until it is long enough to end and a complete segmentation
+//! reaches the last sample),
 //! so the cost is O(query × candidates²); with unlimited candidates the DP is
 //! exact (tested against exhaustive enumeration of segmentations). Near-equal
 //! choices are broken by a hash of (seed, position, choice), so `--seed`
@@ -597,7 +600,21 @@ fn candidates(
             .filter(|t| t.0.is_finite())
             .collect();
         best.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        for &(_, ci) in best.iter().take(o.beam) {
+        let mut keep: Vec<usize> = best.iter().take(o.beam).map(|t| t.1).collect();
+        // Also the best state of every run length: a segment just begun
+        // must survive until it is long enough to end, or the beam can
+        // hold only incomplete runs at the last sample.
+        for r in 0..slots {
+            let top = (0..prev.cands.len())
+                .filter(|&ci| prev.cost[ci * slots + r].is_finite())
+                .min_by(|&a, &b| {
+                    prev.cost[a * slots + r]
+                        .total_cmp(&prev.cost[b * slots + r])
+                        .then(a.cmp(&b))
+                });
+            keep.extend(top);
+        }
+        for ci in keep {
             let (e, s) = prev.cands[ci];
             if s + 1 < lens[e] {
                 all.push((e, s + 1));

@@ -5,6 +5,7 @@
 
 use super::pipeline::{as_branch, brush_query, starts_on, BrushOptions, QueryResult};
 use super::query::{self, QuerySpine};
+use super::synth::{self, Coord, Field};
 use crate::error::{Error, Result};
 use crate::raster::{Grid, Sdf};
 use crate::sketch::Sketch;
@@ -45,61 +46,185 @@ pub fn palette(style: &BrushStyle) -> Vec<Color> {
     out
 }
 
+/// Rings (finest px) by which the coordinate field is continued beyond the
+/// region the matched segments cover before it is read: one coarsest
+/// pixel. The covered region is rasterized at the start level and
+/// upsampled by whole parents, so its edge is a staircase of coarse pixels;
+/// where an exemplar's ink reaches its rib outline the region edge would
+/// clip it along that staircase (a saw-tooth on every stem).
+pub fn border_rings(r: &QueryResult) -> usize {
+    r.canvas.factor.max(1)
+}
+
+/// The field continued `rings` pixels beyond its covered region: ring by
+/// ring, an uncovered pixel with covered 8-neighbours takes the
+/// continuation `μ(q) + J(q)(p − q)` of the first of them in scan order
+/// whose exemplar is the most common among them ([`synth::jacobian`]).
+pub fn extend_field(style: &BrushStyle, field: &Field, rings: usize) -> Field {
+    let mut f = field.clone();
+    let (w, h) = (f.coords.width(), f.coords.height());
+    for _ in 0..rings {
+        let snap = f.clone();
+        let rows: Vec<Vec<(usize, Coord, [f32; 2])>> = (0..h)
+            .into_par_iter()
+            .map(|y| {
+                let mut out = Vec::new();
+                for x in 0..w {
+                    if snap.coords.get(x, y).is_some() {
+                        continue;
+                    }
+                    let mut best: Option<(usize, Coord, [f32; 2])> = None;
+                    let mut counts: Vec<(u32, usize)> = Vec::new();
+                    let mut preds: Vec<(u32, Coord, [f32; 2])> = Vec::new();
+                    for (dx, dy) in NEIGHBOURS {
+                        let (nx, ny) = (x as isize + dx, y as isize + dy);
+                        let Some(c) = snap.coords.get_or(nx, ny, None) else {
+                            continue;
+                        };
+                        let (nx, ny) = (nx as usize, ny as usize);
+                        let Some(j) = synth::jacobian(style, &snap, nx, ny) else {
+                            continue;
+                        };
+                        let d = synth::apply(j, [-dx as f32, -dy as f32]);
+                        let p = Coord {
+                            exemplar: c.exemplar,
+                            x: c.x + d[0],
+                            y: c.y + d[1],
+                        };
+                        match counts.iter_mut().find(|(e, _)| *e == c.exemplar) {
+                            Some(k) => k.1 += 1,
+                            None => counts.push((c.exemplar, 1)),
+                        }
+                        preds.push((c.exemplar, p, snap.orient.get(nx, ny)));
+                    }
+                    let top = counts.iter().map(|c| c.1).max().unwrap_or(0);
+                    if let Some((e, _)) = counts.iter().find(|c| c.1 == top) {
+                        if let Some((_, p, o)) = preds.iter().find(|p| p.0 == *e) {
+                            best = Some((x, *p, *o));
+                        }
+                    }
+                    out.extend(best);
+                }
+                out
+            })
+            .collect();
+        let mut any = false;
+        for (y, row) in rows.into_iter().enumerate() {
+            for (x, c, o) in row {
+                f.coords.set(x, y, Some(c));
+                f.orient.set(x, y, o);
+                any = true;
+            }
+        }
+        if !any {
+            break;
+        }
+    }
+    f
+}
+
+/// Radius of the blended read, px.
+const BLEND: isize = 2;
+/// Binomial weights of the blended read.
+const BINOMIAL: [f32; 5] = [1.0, 4.0, 6.0, 4.0, 1.0];
+
+/// The 8-neighbour offsets in scan order.
+const NEIGHBOURS: [(isize, isize); 8] = [
+    (-1, -1),
+    (0, -1),
+    (1, -1),
+    (-1, 0),
+    (1, 0),
+    (-1, 1),
+    (0, 1),
+    (1, 1),
+];
+
 /// The canvas SDF of one layer colour (or of all ink, `None`) for a
-/// synthesized query: per pixel, the exemplar's finest-level SDF at μ, px;
-/// [`PAPER`] off the ornament or where the exemplar lacks that colour.
+/// synthesized query, px; [`PAPER`] off the ornament. Each pixel `p`
+/// blends the predictions of its 3×3 neighbourhood: neighbour `q` predicts
+/// the coordinate `μ(q) + J(q)(p − q)` (its patch continued to `p`,
+/// [`synth::jacobian`]) and gives the exemplar's SDF there (bilinear);
+/// the values are averaged with binomial weights 1-2-1 (a neighbour whose
+/// exemplar lacks the colour gives paper). Inside a coherent patch every
+/// prediction is `μ(p)` itself and the read is exact; across a seam the
+/// two patches' fields are cross-faded over three pixels, so outlines
+/// cross seams without steps or spurs, and a lone pixel whose μ landed on
+/// another layer's ink (a speck) is outvoted by its neighbours (the
+/// output reading of decobrush.txt §5.4: colours are read through μ, §7).
 pub fn layer_sdf(style: &BrushStyle, r: &QueryResult, color: Option<Color>) -> Grid<f32> {
-    let g = &r.field.coords;
+    let field = extend_field(style, &r.field, border_rings(r));
+    blended_sdf(style, &field, color)
+}
+
+/// [`layer_sdf`] of a given (already extended) field.
+pub fn blended_sdf(style: &BrushStyle, field: &Field, color: Option<Color>) -> Grid<f32> {
+    let g = &field.coords;
     let (w, h) = (g.width(), g.height());
-    let level = r.field.level;
+    let level = field.level;
+    let read = |c: Coord| -> f32 {
+        style
+            .exemplars
+            .get(c.exemplar as usize)
+            .and_then(|e| e.levels.get(level))
+            .and_then(|lv| match color {
+                None => Some(&lv.ink.ink),
+                Some(col) => lv
+                    .ink
+                    .layers
+                    .iter()
+                    .find(|l| l.color == col)
+                    .map(|l| &l.sdf),
+            })
+            .map(|grid| grid.sample(c.x as f64, c.y as f64))
+            .unwrap_or(PAPER)
+    };
+    // Jacobians once per pixel.
+    let jac: Vec<Option<synth::Jacobian>> = (0..h)
+        .into_par_iter()
+        .flat_map_iter(|y| (0..w).map(move |x| synth::jacobian(style, field, x, y)))
+        .collect();
     let rows: Vec<Vec<f32>> = (0..h)
         .into_par_iter()
         .map(|y| {
             (0..w)
                 .map(|x| {
-                    g.get(x, y)
-                        .and_then(|c| {
-                            let lv = style
-                                .exemplars
-                                .get(c.exemplar as usize)?
-                                .levels
-                                .get(level)?;
-                            let grid = match color {
-                                None => &lv.ink.ink,
-                                Some(col) => &lv.ink.layers.iter().find(|l| l.color == col)?.sdf,
+                    if g.get(x, y).is_none() {
+                        return PAPER;
+                    }
+                    let (mut acc, mut wsum) = (0.0f32, 0.0f32);
+                    for dy in -BLEND..=BLEND {
+                        for dx in -BLEND..=BLEND {
+                            let (nx, ny) = (x as isize + dx, y as isize + dy);
+                            let Some(c) = g.get_or(nx, ny, None) else {
+                                continue;
                             };
-                            Some(grid.sample(c.x as f64, c.y as f64))
-                        })
-                        .unwrap_or(PAPER)
+                            let Some(j) = jac.get(ny as usize * w + nx as usize).copied().flatten()
+                            else {
+                                continue;
+                            };
+                            let d = synth::apply(j, [-dx as f32, -dy as f32]);
+                            let wt =
+                                BINOMIAL[(dx + BLEND) as usize] * BINOMIAL[(dy + BLEND) as usize];
+                            let p = Coord {
+                                exemplar: c.exemplar,
+                                x: c.x + d[0],
+                                y: c.y + d[1],
+                            };
+                            acc += wt * read(p);
+                            wsum += wt;
+                        }
+                    }
+                    if wsum > 0.0 {
+                        acc / wsum
+                    } else {
+                        PAPER
+                    }
                 })
                 .collect()
         })
         .collect();
     Grid::from_vec(w, h, rows.concat()).unwrap_or_else(|| Grid::new(w, h, PAPER))
-}
-
-/// One pass of a 3×3 binomial filter over an SDF: per-pixel coordinate
-/// choices leave a staircase of sub-pixel steps along outlines that the
-/// fitter would otherwise follow; a distance field stays a distance field
-/// (up to its curvature) under this small blur.
-pub fn smooth(g: &Grid<f32>) -> Grid<f32> {
-    let (w, h) = (g.width(), g.height());
-    let k = [1.0f32, 2.0, 1.0];
-    Grid::from_fn(w, h, |x, y| {
-        let mut acc = 0.0;
-        for (j, ky) in k.iter().enumerate() {
-            for (i, kx) in k.iter().enumerate() {
-                acc += kx
-                    * ky
-                    * g.get_or(
-                        x as isize + i as isize - 1,
-                        y as isize + j as isize - 1,
-                        g.get(x, y),
-                    );
-            }
-        }
-        acc / 16.0
-    })
 }
 
 /// The 4-connected components of a mask, as lists of pixel indices
@@ -165,32 +290,30 @@ pub fn smallest_exemplar_component(style: &BrushStyle) -> usize {
 }
 
 /// The final per-layer canvas SDFs of a query, bottom layer first, with
-/// their colours: smoothed, and with debris removed — ink components
-/// smaller than the exemplars' smallest, except pieces of at least an
-/// eighth of that on the spine's core band.
+/// their colours: each layer read through the continued field with the
+/// blended read ([`blended_sdf`]); then a last, documented cleanup: ink
+/// components smaller than the exemplars' smallest piece
+/// ([`smallest_exemplar_component`], the threshold taken from the style,
+/// not a constant) are synthesis debris and are cleared; the query's
+/// largest piece is its body and always stays.
 pub fn final_layers(style: &BrushStyle, r: &QueryResult) -> Vec<(Color, Grid<f32>)> {
+    let field = extend_field(style, &r.field, border_rings(r));
     let mut layers: Vec<(Color, Grid<f32>)> = palette(style)
         .into_iter()
-        .map(|c| (c, smooth(&layer_sdf(style, r, Some(c)))))
+        .map(|c| (c, blended_sdf(style, &field, Some(c))))
         .collect();
     let Some((_, first)) = layers.first() else {
         return layers;
     };
     let (w, h) = (first.width(), first.height());
     let ink = Grid::from_fn(w, h, |x, y| layers.iter().any(|(_, g)| g.get(x, y) < 0.0));
-    let min = smallest_exemplar_component(style);
-    // The spine's core band (a quarter width): a piece there of at least
-    // an eighth of the smallest exemplar piece is part of the ornament's
-    // body, broken off or not, and stays.
-    let to_px = r.canvas.to_pixel(1.0);
-    let spine: Vec<kurbo::Point> = r.spine.samples.iter().map(|s| to_px * s.pos).collect();
-    let core = 0.25 * r.spine.width * r.canvas.px_per_unit;
-    let on_core = |i: usize| {
-        let p = kurbo::Point::new((i % w) as f64 + 0.5, (i / w) as f64 + 0.5);
-        spine.iter().any(|q| q.distance(p) <= core)
-    };
-    for comp in components(&ink) {
-        if comp.len() >= min || (8 * comp.len() >= min && comp.iter().any(|&i| on_core(i))) {
+    let comps = components(&ink);
+    // A query shorter than every exemplar can have a body smaller than
+    // the exemplars' smallest piece: the largest piece always stays.
+    let largest = comps.iter().map(Vec::len).max().unwrap_or(0);
+    let min = smallest_exemplar_component(style).min(largest);
+    for comp in comps {
+        if comp.len() >= min {
             continue;
         }
         for (_, g) in &mut layers {
@@ -321,7 +444,6 @@ fn refine_all(
             }
         }
         if let Some(f) = crate::brush::synth::refine(style, &r.levels, &target, &mask, &sopts) {
-            r.energy = crate::brush::synth::energy(style, &f);
             r.field = f;
         }
         out.push(r);

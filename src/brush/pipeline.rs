@@ -88,14 +88,20 @@ pub struct QueryResult {
     pub canvas: Canvas,
     /// The synthesized coordinate field at the finest level.
     pub field: Field,
-    /// The synthesis energy of the final field ([`synth::energy`]).
-    pub energy: f64,
     /// Matched segments (exemplar index, query sample range); empty for the
     /// art-brush baseline.
     pub segments: Vec<(usize, std::ops::Range<usize>)>,
     /// The corrected field of every synthesis level, coarse to fine (for
     /// refinement, §5.5); empty for the baseline.
     pub levels: Vec<Field>,
+}
+
+impl QueryResult {
+    /// The synthesis energy of the final field ([`synth::energy`]):
+    /// computed on demand, it costs about one correction pass.
+    pub fn energy(&self, style: &BrushStyle) -> f64 {
+        synth::energy(style, &self.field)
+    }
 }
 
 /// Narrowest mean stroke width (px) at which a level's 5×5 neighbourhoods
@@ -296,8 +302,13 @@ fn orient_of(
 }
 
 /// Pixels (at the start level) by which the seam regions, where the ANN
-/// search runs, extend beyond the overlaps of matched segments.
-pub const SEAM_MARGIN: isize = 3;
+/// search runs, extend on either side of the graph-cut seams: the radius
+/// of a 5×5 neighbourhood, so exactly the pixels whose neighbourhood
+/// straddles a cut (the "red curves" of decobrush.txt Fig. 6c, §5.4.2).
+/// Elsewhere every pixel's neighbourhood lies in one warped segment and
+/// only the coherent candidates are searched: ANN picks there seed
+/// pixel-sized patches that break lines.
+pub const SEAM_MARGIN: isize = 2;
 
 /// A coordinate field from several warped exemplar segments: owners,
 /// orientation and seam mask.
@@ -331,8 +342,12 @@ fn compose(
                     orient.set(x, y, o);
                 }
             }
-            let covering = fields.iter().filter(|(_, g)| g.get(x, y).is_some()).count();
-            if covering > 1 {
+            let me = owner.get(x, y);
+            let cut = [(1isize, 0isize), (0, 1)].iter().any(|&(dx, dy)| {
+                let o = owner.get_or(x as isize + dx, y as isize + dy, None);
+                o.is_some() && o != me
+            });
+            if cut {
                 for dy in -SEAM_MARGIN..=SEAM_MARGIN {
                     for dx in -SEAM_MARGIN..=SEAM_MARGIN {
                         let (nx, ny) = (x as isize + dx, y as isize + dy);
@@ -534,20 +549,9 @@ fn run_query(
         ..opts.matching.clone()
     };
     let qf = SpineFeatures::from_query(q);
-    // The beam search can lose every complete state on short or unusual
-    // queries; the exhaustive candidate set then decides.
-    let m = match match_query(&qf, &feats, &mopts) {
-        Ok(m) => m,
-        Err(_) => match_query(
-            &qf,
-            &feats,
-            &MatchOptions {
-                candidates: usize::MAX,
-                beam: usize::MAX,
-                ..mopts
-            },
-        )?,
-    };
+    // The beam keeps the best state of every run length, so a complete
+    // segmentation survives to the last sample (no exhaustive retry).
+    let m = match_query(&qf, &feats, &mopts)?;
     let start = opts
         .start_level
         .unwrap_or_else(|| start_level(style, ew))
@@ -595,7 +599,6 @@ fn run_query(
         return Ok(QueryResult {
             spine: q.clone(),
             canvas,
-            energy: synth::energy(style, &init),
             field: init,
             segments,
             levels: Vec::new(),
@@ -610,12 +613,10 @@ fn run_query(
         .last()
         .cloned()
         .ok_or_else(|| Error::degenerate("brush", "synthesis produced no level"))?;
-    let energy = synth::energy(style, &field);
     Ok(QueryResult {
         spine: q.clone(),
         canvas,
         field,
-        energy,
         segments,
         levels,
     })
@@ -651,12 +652,10 @@ fn art_brush(
         fields[0].1.get(x, y).map(|_| 0)
     });
     let field = compose(style, finest, &fields, &owner);
-    let energy = synth::energy(style, &field);
     Ok(QueryResult {
         spine: q.clone(),
         canvas,
         field,
-        energy,
         segments: Vec::new(),
         levels: Vec::new(),
     })

@@ -9,24 +9,31 @@
 //!   [`crate::synth::neighbourhood`] with its up axis along the query
 //!   orientation ω^q. Candidates are the pixel's own μ and the eight
 //!   coherent ones: neighbour n's coordinate continued to p,
-//!   `μ(n) + J_e^T J_q (p − n)`. The nearest by L² wins; near-equal ones
+//!   `μ(n) + J(n) (p − n)` ([`jacobian`]). A candidate's distance is the
+//!   SDF L² plus [`LAYER_WEIGHT`] per disagreeing top layer on the 3×3
+//!   (the SDF sees all ink as one), multiplied by
+//!   `1 + κ (8 − a) / 8` where `a` of the 8 neighbours hold its
+//!   continuation ("strong coherence"). The nearest wins; near-equal ones
 //!   (within a relative tie tolerance) are chosen by a hash of (seed,
-//!   level, pass, pixel). In seam regions the style's k-d tree also gives
-//!   an approximate nearest neighbour over all exemplars, taken when the
-//!   best coherent distance is 5× or more its distance (the paper's rule).
+//!   level, pass, pixel). In seam regions (around the graph cuts) the
+//!   style's k-d tree also gives an approximate nearest neighbour over all
+//!   exemplars, taken when the best coherent distance is 5× or more its
+//!   distance (the paper's rule).
 //! * **Sub-passes.** Pixels are corrected on a 2×2 lattice, four sub-passes
 //!   per iteration; each sub-pass reads only the field left by the previous
 //!   one and writes only its own lattice pixels, so the parallel loop gives
 //!   the same field at any thread count.
 //! * **Upsampling** (§5.4.3). Child `p + Δ` (Δ = (±½, ±½) fine px) of a
-//!   parent p inherits `2 μ(p) + J_e^T J_q Δ`, where `J_q`, `J_e` are the
+//!   parent p inherits `2 μ(p) + J Δ`. The paper's `J = J_e^T J_q` (the
 //!   reflection matrices `[[ω_x, ω_y], [ω_y, −ω_x]]` of the query and
-//!   exemplar orientations: `J_e^T J_q` is the rotation taking the query's
-//!   stroke frame onto the exemplar's.
+//!   exemplar orientations, a rotation) is used where the parent has no
+//!   coherent neighbour; inside a patch `J` is the field's measured
+//!   Jacobian, so a warped segment is continued as the warp it is.
 
 use crate::pattern::rng;
 use crate::raster::Grid;
 use crate::style::brush::{BrushStyle, ExemplarLevel};
+use crate::svg_out::Color;
 use crate::synth::neighbourhood::{Neighbourhood, SIZE};
 use rayon::prelude::*;
 
@@ -59,8 +66,11 @@ pub struct Field {
 /// Synthesis parameters.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SynthOptions {
-    /// Correction iterations per level (each is four sub-passes; default 2;
-    /// 0 gives the graph cut upsampled without correction).
+    /// Correction iterations per level (each is four sub-passes; default 1:
+    /// measured on long queries, each further iteration lowers the
+    /// neighbourhood energy but adds line ends, the structure density
+    /// drifting away from the exemplars'; 0 gives the graph cut upsampled
+    /// without correction).
     pub iterations: usize,
     /// Seed of the choice among near-equal candidates.
     pub seed: u64,
@@ -70,15 +80,20 @@ pub struct SynthOptions {
     /// The coherent candidate is kept unless its distance is this many
     /// times the ANN candidate's (default 5, decobrush.txt §5.4.2).
     pub ann_ratio: f32,
+    /// Coherence weight κ: a candidate continuing none of a pixel's 8
+    /// neighbours has its distance multiplied by `1 + κ`, one continuing
+    /// `a` of them by `1 + κ (8 − a) / 8` (default 1).
+    pub coherence: f32,
 }
 
 impl Default for SynthOptions {
     fn default() -> Self {
         SynthOptions {
-            iterations: 2,
+            iterations: 1,
             seed: 0,
             tie: 0.02,
             ann_ratio: 5.0,
+            coherence: 1.0,
         }
     }
 }
@@ -134,6 +149,68 @@ pub fn carry(q: [f32; 2], e: [f32; 2], d: [f32; 2]) -> [f32; 2] {
     [along * e[0] - across * e[1], along * e[1] + across * e[0]]
 }
 
+/// Largest distance (px of the level) between a neighbour's coordinate and
+/// the continuation of a pixel's coordinate to it under which the two count
+/// as one coherent patch (the same exemplar region, copied without a seam).
+pub const COHERENT: f32 = 1.0;
+
+/// A 2×2 Jacobian `∂μ/∂p` (exemplar px per canvas px): `[column along
+/// canvas x, column along canvas y]`.
+pub type Jacobian = [[f32; 2]; 2];
+
+/// `J d` for a Jacobian and a canvas displacement (px).
+#[inline]
+pub fn apply(j: Jacobian, d: [f32; 2]) -> [f32; 2] {
+    [
+        j[0][0] * d[0] + j[1][0] * d[1],
+        j[0][1] * d[0] + j[1][1] * d[1],
+    ]
+}
+
+/// The rigid Jacobian `J_e^T J_q` of a pixel (§5.4.3): the rotation taking
+/// the query's stroke frame at `(x, y)` onto the exemplar's at `c`.
+fn rigid(style: &BrushStyle, field: &Field, c: Coord, x: usize, y: usize) -> Jacobian {
+    let q = field.orient.get(x, y);
+    let e = exemplar_orientation(style, field.level, c).unwrap_or(q);
+    [carry(q, e, [1.0, 0.0]), carry(q, e, [0.0, 1.0])]
+}
+
+/// The local Jacobian `∂μ/∂p` of the field at pixel `(x, y)`, measured by
+/// differences with the pixel's coherent 4-neighbours (same exemplar,
+/// within [`COHERENT`] of the rigid continuation): central where both
+/// sides cohere, one-sided where one does, the rigid `J_e^T J_q` where
+/// neither does. Inside a warped segment this is the warp's own
+/// stretch, so inheritance and coherent candidates continue the warp
+/// instead of tiling it with rigid copies whose joints step by the stretch
+/// error (a saw-tooth along every outline); at seams it falls back to the
+/// paper's rotation (decobrush.txt §5.4.3).
+pub fn jacobian(style: &BrushStyle, field: &Field, x: usize, y: usize) -> Option<Jacobian> {
+    let c = field.coords.get(x, y)?;
+    let r = rigid(style, field, c, x, y);
+    let mut j = r;
+    for (axis, col) in j.iter_mut().enumerate() {
+        let a = if axis == 0 { (1isize, 0isize) } else { (0, 1) };
+        let side = |s: isize| -> Option<[f32; 2]> {
+            let n = field
+                .coords
+                .get_or(x as isize + s * a.0, y as isize + s * a.1, None)?;
+            if n.exemplar != c.exemplar {
+                return None;
+            }
+            let d = [(n.x - c.x) * s as f32, (n.y - c.y) * s as f32];
+            let rc = r[axis];
+            ((d[0] - rc[0]).hypot(d[1] - rc[1]) < COHERENT).then_some(d)
+        };
+        *col = match (side(1), side(-1)) {
+            (Some(f), Some(b)) => [0.5 * (f[0] + b[0]), 0.5 * (f[1] + b[1])],
+            (Some(f), None) => f,
+            (None, Some(b)) => b,
+            (None, None) => r[axis],
+        };
+    }
+    Some(j)
+}
+
 /// The appearance of a field: per pixel, the exemplar's all-ink SDF at μ
 /// (px), [`PAPER`] off the ornament.
 pub fn appearance(style: &BrushStyle, field: &Field) -> Grid<f32> {
@@ -161,6 +238,104 @@ fn dist2(a: &Neighbourhood, b: &Neighbourhood) -> f32 {
     (0..SIZE).map(|k| (a[k] - b[k]) * (a[k] - b[k])).sum()
 }
 
+/// Weight of one layer disagreement in the neighbourhood distance, in the
+/// units of the normalized SDF L² (a sample differing by the full clamp
+/// range costs 1). The SDF neighbourhoods see all ink as one: a leaf's
+/// inside and a stem's inside look alike, and correction would trade one
+/// for the other, leaving stem-coloured specks in leaves. Comparing the
+/// top layer on the 3×3 around the pixel keeps each layer's pixels on that
+/// layer (the colour extension of §5.4.2 the paper sketches in §7).
+pub const LAYER_WEIGHT: f32 = 1.0;
+
+/// The offsets of the 3×3 layer comparison, row-major.
+const LAYER_OFFSETS: [[f32; 2]; 9] = [
+    [-1.0, -1.0],
+    [0.0, -1.0],
+    [1.0, -1.0],
+    [-1.0, 0.0],
+    [0.0, 0.0],
+    [1.0, 0.0],
+    [-1.0, 1.0],
+    [0.0, 1.0],
+    [1.0, 1.0],
+];
+
+/// The top layer (its colour) of an exemplar at a coordinate of a level;
+/// `None` on paper or outside the exemplar.
+pub fn layer_at(style: &BrushStyle, level: usize, c: Coord) -> Option<Color> {
+    let lv = level_of(style, c.exemplar, level)?;
+    if !(c.x >= 0.0 && c.y >= 0.0) {
+        return None;
+    }
+    // The pixel holding the coordinate: a label needs no interpolation.
+    let (x, y) = (c.x as isize, c.y as isize);
+    lv.ink
+        .layers
+        .iter()
+        .rev()
+        .find(|l| l.sdf.get_or(x, y, 1.0) < 0.0)
+        .map(|l| l.color)
+}
+
+/// The top layer shown by each pixel of a field (`None`: paper).
+pub fn layer_look(style: &BrushStyle, field: &Field) -> Grid<Option<Color>> {
+    let (w, h) = (field.coords.width(), field.coords.height());
+    let rows: Vec<Vec<Option<Color>>> = (0..h)
+        .into_par_iter()
+        .map(|y| {
+            (0..w)
+                .map(|x| {
+                    field
+                        .coords
+                        .get(x, y)
+                        .and_then(|c| layer_at(style, field.level, c))
+                })
+                .collect()
+        })
+        .collect();
+    Grid::from_vec(w, h, rows.concat()).unwrap_or_else(|| Grid::new(w, h, None))
+}
+
+/// The query's layers on the 3×3 around `(x, y)`.
+fn query_layers(layers: &Grid<Option<Color>>, x: usize, y: usize) -> [Option<Color>; 9] {
+    let mut out = [None; 9];
+    for (k, o) in LAYER_OFFSETS.iter().enumerate() {
+        out[k] = layers.get_or(x as isize + o[0] as isize, y as isize + o[1] as isize, None);
+    }
+    out
+}
+
+/// Layer disagreements between the query's 3×3 and candidate `c`'s
+/// (the canvas offsets carried by the rigid `J_e^T J_q` of `c` at the
+/// pixel), times [`LAYER_WEIGHT`].
+fn layer_cost(
+    style: &BrushStyle,
+    field: &Field,
+    q: &[Option<Color>; 9],
+    c: Coord,
+    x: usize,
+    y: usize,
+) -> f32 {
+    let j = rigid(style, field, c, x, y);
+    let mut n = 0;
+    for (k, o) in LAYER_OFFSETS.iter().enumerate() {
+        let d = apply(j, *o);
+        let e = layer_at(
+            style,
+            field.level,
+            Coord {
+                exemplar: c.exemplar,
+                x: c.x + d[0],
+                y: c.y + d[1],
+            },
+        );
+        if e != q[k] {
+            n += 1;
+        }
+    }
+    LAYER_WEIGHT * n as f32
+}
+
 /// The query neighbourhood of canvas pixel `(x, y)` in appearance `look`.
 fn query_neighbourhood(
     style: &BrushStyle,
@@ -181,6 +356,7 @@ fn query_neighbourhood(
 /// (pixels whose μ left the stroke region count as the largest distance).
 pub fn energy(style: &BrushStyle, field: &Field) -> f64 {
     let look = appearance(style, field);
+    let layers = layer_look(style, field);
     let (w, h) = (field.coords.width(), field.coords.height());
     let rows: Vec<(f64, usize)> = (0..h)
         .into_par_iter()
@@ -189,8 +365,9 @@ pub fn energy(style: &BrushStyle, field: &Field) -> f64 {
             for x in 0..w {
                 if let Some(c) = field.coords.get(x, y) {
                     let q = query_neighbourhood(style, &look, field, x, y);
+                    let ql = query_layers(&layers, x, y);
                     let d = exemplar_neighbourhood(style, field.level, c)
-                        .map(|e| dist2(&q, &e))
+                        .map(|e| dist2(&q, &e) + layer_cost(style, field, &ql, c, x, y))
                         .unwrap_or(4.0 * SIZE as f32);
                     acc.0 += d as f64;
                     acc.1 += 1;
@@ -209,11 +386,37 @@ pub fn energy(style: &BrushStyle, field: &Field) -> f64 {
     }
 }
 
+/// How many of the 8 neighbours of `(x, y)` hold the continuation of
+/// candidate `c` (same exemplar, within [`COHERENT`] of `c + J (n − p)`
+/// with the rigid `J_e^T J_q` of `c`): the candidate's coherence with its
+/// surroundings.
+fn agreement(style: &BrushStyle, field: &Field, c: Coord, x: usize, y: usize) -> usize {
+    let j = rigid(style, field, c, x, y);
+    let mut n = 0;
+    for (k, o) in LAYER_OFFSETS.iter().enumerate() {
+        if k == 4 {
+            continue;
+        }
+        let Some(m) =
+            field
+                .coords
+                .get_or(x as isize + o[0] as isize, y as isize + o[1] as isize, None)
+        else {
+            continue;
+        };
+        let d = apply(j, *o);
+        if m.exemplar == c.exemplar && (c.x + d[0] - m.x).hypot(c.y + d[1] - m.y) < COHERENT {
+            n += 1;
+        }
+    }
+    n
+}
+
 /// The corrected coordinate of one pixel (see the module docs).
 fn correct_pixel(
     style: &BrushStyle,
     field: &Field,
-    look: &Grid<f32>,
+    (look, layers): (&Grid<f32>, &Grid<Option<Color>>),
     opts: &SynthOptions,
     pass: u64,
     x: usize,
@@ -221,10 +424,12 @@ fn correct_pixel(
 ) -> Option<Coord> {
     let cur = field.coords.get(x, y)?;
     let q = query_neighbourhood(style, look, field, x, y);
+    let ql = query_layers(layers, x, y);
+    let cost = |n: &Neighbourhood, c: Coord| dist2(&q, n) + layer_cost(style, field, &ql, c, x, y);
     let l = field.level;
     let mut cands: Vec<(f32, Coord)> = Vec::with_capacity(10);
     if let Some(n) = exemplar_neighbourhood(style, l, cur) {
-        cands.push((dist2(&q, &n), cur));
+        cands.push((cost(&n, cur), cur));
     }
     let (w, h) = (
         field.coords.width() as isize,
@@ -240,10 +445,10 @@ fn correct_pixel(
             let Some(cn) = field.coords.get(nx, ny) else {
                 continue;
             };
-            let Some(oe) = exemplar_orientation(style, l, cn) else {
+            let Some(jn) = jacobian(style, field, nx, ny) else {
                 continue;
             };
-            let d = carry(field.orient.get(nx, ny), oe, [-dx as f32, -dy as f32]);
+            let d = apply(jn, [-dx as f32, -dy as f32]);
             let c = Coord {
                 exemplar: cn.exemplar,
                 x: cn.x + d[0],
@@ -253,14 +458,24 @@ fn correct_pixel(
                 continue;
             }
             if let Some(n) = exemplar_neighbourhood(style, l, c) {
-                cands.push((dist2(&q, &n), c));
+                cands.push((cost(&n, c), c));
             }
         }
     }
     let best = cands.iter().map(|c| c.0).fold(f32::INFINITY, f32::min);
-    let near: Vec<Coord> = cands
+    // Coherence (§5.4.2, "strong coherence"): a candidate's distance grows
+    // with the share of the 8 neighbours it does not continue.
+    let scored: Vec<(f32, Coord)> = cands
         .iter()
-        .filter(|c| c.0 <= best * (1.0 + opts.tie))
+        .map(|&(d, c)| {
+            let apart = 8 - agreement(style, field, c, x, y);
+            (d * (1.0 + opts.coherence * apart as f32 / 8.0), c)
+        })
+        .collect();
+    let top = scored.iter().map(|c| c.0).fold(f32::INFINITY, f32::min);
+    let near: Vec<Coord> = scored
+        .iter()
+        .filter(|c| c.0 <= top * (1.0 + opts.tie))
         .map(|c| c.1)
         .collect();
     // An exact match keeps its coordinate (an exemplar copy is a fixed
@@ -281,7 +496,7 @@ fn correct_pixel(
                     y: r.y as f32 + 0.5,
                 };
                 if let Some(n) = exemplar_neighbourhood(style, l, c) {
-                    let da = dist2(&q, &n);
+                    let da = cost(&n, c);
                     if !best.is_finite() || best > opts.ann_ratio * da {
                         pick = c;
                     }
@@ -307,6 +522,7 @@ pub fn correct_in(
 ) {
     let (w, h) = (field.coords.width(), field.coords.height());
     let mut look = appearance(style, field);
+    let mut layers = layer_look(style, field);
     for it in 0..opts.iterations {
         for (k, (ox, oy)) in [(0usize, 0usize), (1, 1), (1, 0), (0, 1)]
             .into_iter()
@@ -320,13 +536,14 @@ pub fn correct_in(
                 .into_par_iter()
                 .flat_map_iter(|y| {
                     let look = &look;
+                    let layers = &layers;
                     (ox..w).step_by(2).filter_map(move |x| {
                         let cur = snapshot.coords.get(x, y);
                         cur?;
                         if only.is_some_and(|m| !m.get(x, y)) {
                             return None;
                         }
-                        let new = correct_pixel(style, snapshot, look, opts, pass, x, y);
+                        let new = correct_pixel(style, snapshot, (look, layers), opts, pass, x, y);
                         (new != cur).then_some((x, y, new))
                     })
                 })
@@ -334,6 +551,7 @@ pub fn correct_in(
             for (x, y, c) in updates {
                 field.coords.set(x, y, c);
                 look.set(x, y, pixel_look(style, field.level, c));
+                layers.set(x, y, c.and_then(|c| layer_at(style, field.level, c)));
             }
         }
     }
@@ -353,8 +571,7 @@ pub fn upsample(style: &BrushStyle, field: &Field) -> Field {
             if x % 2 == 0 { -0.5 } else { 0.5 },
             if y % 2 == 0 { -0.5 } else { 0.5 },
         ];
-        let oe = exemplar_orientation(style, l, c).unwrap_or(field.orient.get(px, py));
-        let d = carry(field.orient.get(px, py), oe, delta);
+        let d = apply(jacobian(style, field, px, py)?, delta);
         Some(Coord {
             exemplar: c.exemplar,
             x: 2.0 * c.x + d[0],
