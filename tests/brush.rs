@@ -466,7 +466,7 @@ fn bad_input_is_refused_or_skipped_clearly() {
 }
 
 #[test]
-fn refinement_erases_under_white_strokes_and_locks_the_rest() {
+fn refinement_adds_under_black_strokes_erases_under_white_and_locks_the_rest() {
     let style = style("doodle");
     let sk = sketch("s-curve");
     let plain = brush_sketch(style, &sk, &BrushOptions::default()).unwrap();
@@ -502,6 +502,30 @@ fn refinement_erases_under_white_strokes_and_locks_the_rest() {
         }
     }
     eprintln!("ink under the eraser: {before} px before, {after} px after; {changed_far} px changed far from the strokes");
+    // The black stroke (4 units wide) asks for ornament where there was
+    // little: the share of its centre line with ink within 3 units.
+    let add = kurbo::CubicBez::new(
+        (300.0, 110.0),
+        (320.0, 90.0),
+        (340.0, 100.0),
+        (330.0, 120.0),
+    );
+    let inked_near = |r: &QueryResult, g: &Grid<bool>, p: Point| {
+        (0..g.height())
+            .any(|y| (0..g.width()).any(|x| g.get(x, y) && at(r, x, y).distance(p) < 3.0))
+    };
+    let samples: Vec<Point> = (0..=40)
+        .map(|k| kurbo::ParamCurve::eval(&add, k as f64 / 40.0))
+        .collect();
+    let share = |r: &QueryResult, g: &Grid<bool>| {
+        samples.iter().filter(|&&p| inked_near(r, g, p)).count() as f64 / samples.len() as f64
+    };
+    let (add_before, add_after) = (share(a, &ia), share(b, &ib));
+    eprintln!("black stroke with ink within 3 units: {add_before:.2} before, {add_after:.2} after");
+    assert!(
+        add_after >= 0.8 && add_after > add_before + 0.3,
+        "the black stroke added too little: {add_before:.2} -> {add_after:.2}"
+    );
     assert!(before > 0, "the eraser crosses ink");
     assert!(
         after * 4 < before,

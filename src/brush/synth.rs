@@ -616,14 +616,60 @@ pub fn synthesize_levels(style: &BrushStyle, init: Field, opts: &SynthOptions) -
     }
 }
 
+/// Gives every `mask`ed pixel of `field` the exemplar coordinate whose
+/// neighbourhood is nearest to the `target` appearance there (`target` is
+/// at the finest level, `down` finest pixels per pixel of `field`), with
+/// no coherence: the seed of a refined region (§5.5).
+fn seed_from_target(
+    style: &BrushStyle,
+    field: &mut Field,
+    target: &Grid<f32>,
+    mask: &Grid<bool>,
+    down: usize,
+) -> Option<()> {
+    let mut look = appearance(style, field);
+    for y in 0..look.height() {
+        for x in 0..look.width() {
+            if mask.get_or(x as isize, y as isize, false) {
+                let t = target.get_or(
+                    (x * down + down / 2) as isize,
+                    (y * down + down / 2) as isize,
+                    PAPER,
+                );
+                look.set(x, y, t / down as f32);
+            }
+        }
+    }
+    let index = style.indexes.get(field.level)?;
+    for y in 0..look.height() {
+        for x in 0..look.width() {
+            if !mask.get_or(x as isize, y as isize, false) {
+                continue;
+            }
+            let q = query_neighbourhood(style, &look, field, x, y);
+            if let Some((r, _)) = index.nearest(&q) {
+                field.coords.set(
+                    x,
+                    y,
+                    Some(Coord {
+                        exemplar: r.exemplar,
+                        x: r.x as f32 + 0.5,
+                        y: r.y as f32 + 0.5,
+                    }),
+                );
+            }
+        }
+    }
+    Some(())
+}
+
 /// User-guided refinement (decobrush.txt §5.5). `levels` are a synthesis's
 /// fields coarse to fine; `target` the finest-level appearance the user
 /// asks for (ink SDF, px: the synthesized one with added strokes inked and
-/// erased ones cleared) and `mask` the dilated refined pixels. At the
-/// coarsest level the masked pixels take the nearest exemplar
-/// neighbourhood of the target (no coherence), then every level is
-/// upsampled and corrected inside the mask only; outside it the original
-/// coordinates stay locked.
+/// erased ones cleared) and `mask` the dilated refined pixels. At every
+/// level, coarse to fine, the masked pixels take the nearest exemplar
+/// neighbourhood of the target (no coherence) and are then corrected
+/// inside the mask only; outside it the original coordinates stay locked.
 pub fn refine(
     style: &BrushStyle,
     levels: &[Field],
@@ -644,40 +690,7 @@ pub fn refine(
     };
     let mut field = first.clone();
     let m0 = mask_at(0, &field);
-    let d0 = down(0);
-    let mut look = appearance(style, &field);
-    for y in 0..look.height() {
-        for x in 0..look.width() {
-            if m0.get(x, y) {
-                let t = target.get_or(
-                    (x * d0 + d0 / 2) as isize,
-                    (y * d0 + d0 / 2) as isize,
-                    PAPER,
-                );
-                look.set(x, y, t / d0 as f32);
-            }
-        }
-    }
-    let index = style.indexes.get(field.level)?;
-    for y in 0..look.height() {
-        for x in 0..look.width() {
-            if !m0.get(x, y) {
-                continue;
-            }
-            let q = query_neighbourhood(style, &look, &field, x, y);
-            if let Some((r, _)) = index.nearest(&q) {
-                field.coords.set(
-                    x,
-                    y,
-                    Some(Coord {
-                        exemplar: r.exemplar,
-                        x: r.x as f32 + 0.5,
-                        y: r.y as f32 + 0.5,
-                    }),
-                );
-            }
-        }
-    }
+    seed_from_target(style, &mut field, target, &m0, down(0))?;
     correct_in(style, &mut field, opts, Some(&m0));
     for (k, original) in levels.iter().enumerate().skip(1) {
         let mut next = upsample(style, &field);
@@ -690,6 +703,10 @@ pub fn refine(
                 }
             }
         }
+        // The user's strokes guide every level, not only the coarsest:
+        // corrected on its own, a finer level pulls the thin added seed back
+        // to what the neighbourhoods around it expect (the original).
+        seed_from_target(style, &mut next, target, &mk, down(k))?;
         correct_in(style, &mut next, opts, Some(&mk));
         field = next;
     }
