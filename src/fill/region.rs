@@ -113,6 +113,35 @@ impl Region {
         );
     }
 
+    /// Sets the direction field from combing strokes (polylines in sketch
+    /// units, each with its width in sketch units): the strokes' tangents
+    /// diffused over the whole region by normalized convolution (std a
+    /// quarter of the grid's shorter side, as the boundary flow), then each
+    /// stroke combs its own width on top ([`Region::comb`], Brushables
+    /// §3.1). A combed region thus follows its strokes everywhere instead of
+    /// keeping the outline's flow away from them, whose singularities (the
+    /// vortex of a closed outline) a pattern with one "up", such as scales,
+    /// cannot follow. Without strokes the field is left as it is.
+    pub fn comb_all(&mut self, strokes: &[(&[Point], f64)]) {
+        if strokes.iter().all(|(p, _)| p.len() < 2) {
+            return;
+        }
+        let to_px = self.sdf.to_user.inverse();
+        let samples: Vec<diffusion::StrokeSample> = strokes
+            .iter()
+            .flat_map(|(pts, _)| {
+                let px: Vec<Point> = pts.iter().map(|&p| to_px * p).collect();
+                diffusion::sample_polyline(&px, 1.0)
+            })
+            .collect();
+        let (w, h) = (self.width(), self.height());
+        let sigma = (w.min(h) as f64 / 4.0).max(2.0);
+        self.direction = diffusion::boundary_field(w, h, &samples, sigma);
+        for (pts, width) in strokes {
+            self.comb(pts, *width);
+        }
+    }
+
     /// Width of the grid, pixels.
     pub fn width(&self) -> usize {
         self.mask.width()
