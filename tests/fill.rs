@@ -602,3 +602,29 @@ fn the_scales_keep_whole_arcs_in_rows_under_a_constant_field_and_combed() {
     assert!(whole >= 0.7, "combed: {whole}");
     assert!(regular >= 0.9, "combed: {regular}");
 }
+
+#[test]
+fn a_pyramid_level_is_added_only_while_every_layer_survives_halving() {
+    // The scales' orange arc (2.4 units) is 1.8 px wide at half of a 96 px
+    // tile but 0.9 px at a quarter, where its SDF barely dips below zero:
+    // three asked-for levels give two. The knot's bands (128 px) survive
+    // to a quarter: three levels.
+    let dir = constant_field(40, 40, [1.0, 0.0]);
+    let params = em::EmParams {
+        levels: 3,
+        iterations: 1,
+        ..Default::default()
+    };
+    for (name, res, want) in [("scales", 96, 2), ("knot", 128, 3)] {
+        let tile = Tile::load(
+            &root().join(format!("styles/{name}/tile.svg")),
+            res,
+            SourceDirection::Constant([1.0, 0.0]),
+        )
+        .unwrap();
+        let quarter = tile.half().half();
+        assert_eq!(em::represents_every_layer(&quarter), want == 3, "{name}");
+        let s = em::synthesize(&tile, &dir, &params);
+        assert_eq!(s.energy.len(), want, "{name}");
+    }
+}
