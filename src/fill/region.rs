@@ -232,6 +232,40 @@ mod tests {
     }
 
     #[test]
+    fn combing_strokes_set_the_whole_field_without_the_outlines_vortex() {
+        // A 100×60 rectangle: its boundary flow circles the centre, so the
+        // bottom-left corner runs roughly opposite to the top-right one.
+        let p = Rect::new(0.0, 0.0, 100.0, 60.0).to_path(0.1);
+        let r = Region::rasterize(Path::new("s.svg"), "q", &p, FillRule::NonZero, 1.0, 2).unwrap();
+        let (a, b) = (r.direction.get(5, 55), r.direction.get(95, 5));
+        assert!(a[0] * b[0] + a[1] * b[1] < 0.0, "{a:?} {b:?}");
+        // A thin stroke rising at 30° across the middle (grid px = units
+        // + 2).
+        let (c, s) = (30f64.to_radians().cos(), -(30f64.to_radians().sin()));
+        let stroke = [
+            Point::new(50.0 - 30.0 * c, 30.0 - 30.0 * s),
+            Point::new(50.0 + 30.0 * c, 30.0 + 30.0 * s),
+        ];
+        // Combing alone leaves the far edge to the boundary flow.
+        let mut only = r.clone();
+        only.comb(&stroke, 4.0);
+        let o = only.direction.get(50, 57);
+        assert!(o[0] as f64 * c + o[1] as f64 * s < 0.9, "{o:?}");
+        // comb_all turns every pixel to the stroke's direction.
+        let mut all = r.clone();
+        all.comb_all(&[(&stroke, 4.0)]);
+        for (x, y) in [(5, 55), (95, 5), (5, 5), (95, 55), (50, 30), (50, 57)] {
+            let d = all.direction.get(x, y);
+            let cos = d[0] as f64 * c + d[1] as f64 * s;
+            assert!(cos > 0.999, "({x}, {y}): {d:?}");
+        }
+        // No strokes: nothing changes.
+        let mut none = r.clone();
+        none.comb_all(&[]);
+        assert_eq!(none.direction.data(), r.direction.data());
+    }
+
+    #[test]
     fn a_speck_is_refused() {
         let p = Circle::new((5.0, 5.0), 0.2).to_path(0.01);
         let e = Region::rasterize(Path::new("s.svg"), "dot", &p, FillRule::NonZero, 1.0, 0)
