@@ -56,6 +56,25 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         st.px_per_unit(),
         params.radius + 2,
     )?;
+    // The sample's open paths comb the field, as `fill_sketch` does.
+    let strokes: Vec<(Vec<kurbo::Point>, f64)> = sk
+        .queries
+        .iter()
+        .filter_map(|q| match &q.kind {
+            QueryKind::Path { spine, width } => {
+                let mut pts = Vec::new();
+                kurbo::flatten(spine, 0.1, |el| match el {
+                    kurbo::PathEl::MoveTo(p) | kurbo::PathEl::LineTo(p) => pts.push(p),
+                    _ => {}
+                });
+                Some((pts, *width))
+            }
+            _ => None,
+        })
+        .collect();
+    let combing: Vec<(&[kurbo::Point], f64)> =
+        strokes.iter().map(|(p, w)| (p.as_slice(), *w)).collect();
+    region.comb_all(&combing);
     if let Some(deg) = a.get(8).and_then(|s| s.parse::<f64>().ok()) {
         let t = deg.to_radians();
         region.direction = flourish::field::diffusion::constant_field(

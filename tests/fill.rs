@@ -527,3 +527,104 @@ fn the_energy_with_the_shape_hint_decreases_in_a_region() {
         assert!(last < first, "level {level}: {e:?}");
     }
 }
+
+/// Whole-arc figures of a scales result: the share of the orange inner
+/// arcs (layer 1 less the dot above it) lying wholly inside `counted` whose area is within
+/// 0.6–1.6× the tile's arc, and the share of the scales' paper gaps (layer
+/// 0) within 1.6× of the tile's gap.
+fn scales_figures(
+    layers: &[flourish::raster::Grid<f32>],
+    counted: &flourish::raster::Grid<bool>,
+    tile: &Tile,
+) -> (f64, f64) {
+    use flourish::fill::continuity::{pieces, regular_gaps, tile_gap_area};
+    use flourish::raster::Grid;
+    let (tw, th) = (tile.width(), tile.height());
+    // The tile's arcs, whole: pieces of a 3×3 repeat not touching its rim.
+    let rep = Grid::from_fn(3 * tw, 3 * th, |x, y| {
+        tile.layers[1].sdf.get(x % tw, y % th) < 0.0
+            && tile.layers[2].sdf.get(x % tw, y % th) >= 0.0
+    });
+    let inner = Grid::from_fn(3 * tw, 3 * th, |x, y| {
+        x > 0 && y > 0 && x + 1 < 3 * tw && y + 1 < 3 * th
+    });
+    let arcs = pieces(&rep, &inner);
+    let mut areas: Vec<usize> = arcs.iter().filter(|p| p.within).map(|p| p.area).collect();
+    areas.sort_unstable();
+    let arc = areas[areas.len() / 2] as f64;
+    // Orange ink: layer 1 extends under the dot (layer 2).
+    let (w, h) = (layers[1].width(), layers[1].height());
+    let orange = Grid::from_fn(w, h, |x, y| {
+        layers[1].get(x, y) < 0.0 && layers[2].get(x, y) >= 0.0
+    });
+    let got = pieces(&orange, counted);
+    // Slivers of a few pixels where the dot's outline and the orange
+    // layer's extension under it differ are no arcs (the tracer drops them).
+    let inside: Vec<_> = got
+        .iter()
+        .filter(|p| p.within && p.area as f64 >= 0.1 * arc)
+        .collect();
+    let whole = inside
+        .iter()
+        .filter(|p| (0.6 * arc..=1.6 * arc).contains(&(p.area as f64)))
+        .count() as f64
+        / inside.len().max(1) as f64;
+    let gap = tile_gap_area(&tile.layers[0].sdf.map(|d| d >= 0.0));
+    let regular = regular_gaps(&layers[0].map(|d| d >= 0.0), counted, gap, 1.6);
+    (whole, regular)
+}
+
+#[test]
+fn the_scales_keep_whole_arcs_in_rows_under_a_constant_field_and_combed() {
+    let style = flourish::fill::FillStyle::load(&root().join("styles/scales"), None).unwrap();
+    let tile = &style.tile;
+    // A 200×200 px disc under a constant field at 20°.
+    let n = 200usize;
+    let disc = flourish::raster::Grid::from_fn(n, n, |x, y| {
+        (x as f32 + 0.5 - 100.0).hypot(y as f32 + 0.5 - 100.0) - 94.0
+    });
+    let mask = disc.map(|d| d < 0.0);
+    let dir = constant_field(n, n, [20f64.to_radians().cos(), 20f64.to_radians().sin()]);
+    let s = em::synthesize_in(tile, &dir, Some(&mask), &style.params);
+    let (whole, regular) = scales_figures(&s.layers, &disc.map(|d| d < -4.0), tile);
+    println!("constant: whole arcs {whole:.3}, regular gaps {regular:.3}");
+    assert!(whole >= 0.85, "constant: {whole}");
+    assert!(regular >= 0.95, "constant: {regular}");
+    // The combed sample: the wide stroke sets the field over the whole
+    // rounded rectangle (its outline's own flow would turn a full circle
+    // around a vortex, which rows of scales cannot follow).
+    let out = run_full("scales", "combed");
+    let r = &out.regions[0];
+    let counted = r.region.sdf.dist.map(|d| d < -4.0);
+    let (whole, regular) = scales_figures(&r.layers, &counted, tile);
+    println!("combed: whole arcs {whole:.3}, regular gaps {regular:.3}");
+    // (Under the outline's vortex flow: 0.42 whole arcs, 0.78 regular.)
+    assert!(whole >= 0.7, "combed: {whole}");
+    assert!(regular >= 0.9, "combed: {regular}");
+}
+
+#[test]
+fn a_pyramid_level_is_added_only_while_every_layer_survives_halving() {
+    // The scales' orange arc (2.4 units) is 1.8 px wide at half of a 96 px
+    // tile but 0.9 px at a quarter, where its SDF barely dips below zero:
+    // three asked-for levels give two. The knot's bands (128 px) survive
+    // to a quarter: three levels.
+    let dir = constant_field(40, 40, [1.0, 0.0]);
+    let params = em::EmParams {
+        levels: 3,
+        iterations: 1,
+        ..Default::default()
+    };
+    for (name, res, want) in [("scales", 96, 2), ("knot", 128, 3)] {
+        let tile = Tile::load(
+            &root().join(format!("styles/{name}/tile.svg")),
+            res,
+            SourceDirection::Constant([1.0, 0.0]),
+        )
+        .unwrap();
+        let quarter = tile.half().half();
+        assert_eq!(em::represents_every_layer(&quarter), want == 3, "{name}");
+        let s = em::synthesize(&tile, &dir, &params);
+        assert_eq!(s.energy.len(), want, "{name}");
+    }
+}

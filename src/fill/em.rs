@@ -32,7 +32,8 @@ pub struct EmParams {
     pub alpha: f32,
     /// Finest patch radius `r` (patches are `(2r+1)²`).
     pub radius: usize,
-    /// Pyramid levels (1 = finest only).
+    /// Pyramid levels (1 = finest only), at most: a level is only added
+    /// while its tile [`represents_every_layer`].
     pub levels: usize,
     /// EM iterations `N` per neighbourhood size (a quarter of them at the
     /// finest level of a pyramid, at least one: CaTS §4.1 reduces the
@@ -69,7 +70,7 @@ pub struct Synthesis {
     pub layers: Vec<Grid<f32>>,
     /// Voted colour (0..1 RGB).
     pub colour: Grid<[f32; 3]>,
-    /// Eq. 6 energy ([`interior_energy`]) per level (coarse first): of the
+    /// Eq. 6 energy ([`interior_energy`]) per level used (coarse first): of the
     /// level's initial matches, then after each M-step, per neighbourhood
     /// size and iteration in order.
     pub energy: Vec<Vec<f64>>,
@@ -97,12 +98,15 @@ pub fn synthesize_in(
     params: &EmParams,
 ) -> Synthesis {
     let (width, height) = (direction.width(), direction.height());
-    let levels = params.levels.max(1);
     let mut tiles = vec![tile.clone()];
-    for _ in 1..levels {
+    while tiles.len() < params.levels {
         let t = tiles[tiles.len() - 1].half();
+        if !represents_every_layer(&t) {
+            break;
+        }
         tiles.push(t);
     }
+    let levels = tiles.len();
     let mut state: Option<State> = None;
     let mut nnf: Option<Nnf> = None;
     let mut energy = Vec::new();
@@ -284,6 +288,22 @@ pub fn synthesize_in(
         colour: st.colour,
         energy,
     }
+}
+
+/// Least depth, pixels, that every layer's ink must reach somewhere in a
+/// pyramid level's tile: half a pixel, a stroke one pixel wide.
+pub const MIN_LEVEL_DEPTH: f32 = 0.5;
+
+/// Whether a (halved) tile still holds every layer: each layer's SDF
+/// reaches [`MIN_LEVEL_DEPTH`] inside. Strokes thinner than a pixel break
+/// into dots or vanish at that level (the scales' 2.4-unit arcs in a 96 px
+/// tile at quarter resolution), and the coarsest level, which lays out the
+/// whole pattern (Alg. 1), would lay it out from debris.
+pub fn represents_every_layer(t: &Tile) -> bool {
+    t.layers.iter().all(|l| {
+        let deepest = l.sdf.data().iter().copied().fold(0.0f32, f32::min);
+        -deepest >= MIN_LEVEL_DEPTH
+    })
 }
 
 /// Eq. 6 over the neighbourhoods that lie inside the grid (those crossing

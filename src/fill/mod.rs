@@ -273,15 +273,14 @@ pub fn fill_sketch(opts: &FillOptions, sk: &Sketch) -> Result<FillOutput> {
         max_ppu = max_ppu.max(ppu);
         let margin = st.params.radius + 2;
         let mut region = Region::rasterize(&sk.path, &q.id, outline, rule, ppu, margin)?;
-        let mut combed = 0;
-        for (pts, width) in strokes
+        let combing: Vec<(&[Point], f64)> = strokes
             .iter()
             .filter(|(pts, _)| mostly_inside(outline, rule, pts))
             .chain(&global)
-        {
-            region.comb(pts, *width);
-            combed += 1;
-        }
+            .map(|(pts, width)| (pts.as_slice(), *width))
+            .collect();
+        region.comb_all(&combing);
+        let combed = combing.len();
         notes.push(format!(
             "{}: style {name}, {}×{} px grid, {} px inside, {combed} combing stroke(s)",
             q.id,

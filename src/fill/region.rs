@@ -113,6 +113,35 @@ impl Region {
         );
     }
 
+    /// Sets the direction field from combing strokes (polylines in sketch
+    /// units, each with its width in sketch units): the strokes' tangents
+    /// diffused over the whole region by normalized convolution (std a
+    /// quarter of the grid's shorter side, as the boundary flow), then each
+    /// stroke combs its own width on top ([`Region::comb`], Brushables
+    /// §3.1). A combed region thus follows its strokes everywhere instead of
+    /// keeping the outline's flow away from them, whose singularities (the
+    /// vortex of a closed outline) a pattern with one "up", such as scales,
+    /// cannot follow. Without strokes the field is left as it is.
+    pub fn comb_all(&mut self, strokes: &[(&[Point], f64)]) {
+        if strokes.iter().all(|(p, _)| p.len() < 2) {
+            return;
+        }
+        let to_px = self.sdf.to_user.inverse();
+        let samples: Vec<diffusion::StrokeSample> = strokes
+            .iter()
+            .flat_map(|(pts, _)| {
+                let px: Vec<Point> = pts.iter().map(|&p| to_px * p).collect();
+                diffusion::sample_polyline(&px, 1.0)
+            })
+            .collect();
+        let (w, h) = (self.width(), self.height());
+        let sigma = (w.min(h) as f64 / 4.0).max(2.0);
+        self.direction = diffusion::boundary_field(w, h, &samples, sigma);
+        for (pts, width) in strokes {
+            self.comb(pts, *width);
+        }
+    }
+
     /// Width of the grid, pixels.
     pub fn width(&self) -> usize {
         self.mask.width()
@@ -200,6 +229,40 @@ mod tests {
                 assert_eq!(g.get(x, y), p.winding(c) % 2 != 0, "{x} {y}");
             }
         }
+    }
+
+    #[test]
+    fn combing_strokes_set_the_whole_field_without_the_outlines_vortex() {
+        // A 100×60 rectangle: its boundary flow circles the centre, so the
+        // bottom-left corner runs roughly opposite to the top-right one.
+        let p = Rect::new(0.0, 0.0, 100.0, 60.0).to_path(0.1);
+        let r = Region::rasterize(Path::new("s.svg"), "q", &p, FillRule::NonZero, 1.0, 2).unwrap();
+        let (a, b) = (r.direction.get(5, 55), r.direction.get(95, 5));
+        assert!(a[0] * b[0] + a[1] * b[1] < 0.0, "{a:?} {b:?}");
+        // A thin stroke rising at 30° across the middle (grid px = units
+        // + 2).
+        let (c, s) = (30f64.to_radians().cos(), -(30f64.to_radians().sin()));
+        let stroke = [
+            Point::new(50.0 - 30.0 * c, 30.0 - 30.0 * s),
+            Point::new(50.0 + 30.0 * c, 30.0 + 30.0 * s),
+        ];
+        // Combing alone leaves the far edge to the boundary flow.
+        let mut only = r.clone();
+        only.comb(&stroke, 4.0);
+        let o = only.direction.get(50, 57);
+        assert!(o[0] as f64 * c + o[1] as f64 * s < 0.9, "{o:?}");
+        // comb_all turns every pixel to the stroke's direction.
+        let mut all = r.clone();
+        all.comb_all(&[(&stroke, 4.0)]);
+        for (x, y) in [(5, 55), (95, 5), (5, 5), (95, 55), (50, 30), (50, 57)] {
+            let d = all.direction.get(x, y);
+            let cos = d[0] as f64 * c + d[1] as f64 * s;
+            assert!(cos > 0.999, "({x}, {y}): {d:?}");
+        }
+        // No strokes: nothing changes.
+        let mut none = r.clone();
+        none.comb_all(&[]);
+        assert_eq!(none.direction.data(), r.direction.data());
     }
 
     #[test]
