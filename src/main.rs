@@ -290,6 +290,7 @@ fn run_trace(args: TraceArgs, quiet: bool) -> Result<(), Failure> {
         args.out.preview.as_deref(),
         quiet,
         &job,
+        None,
     )
 }
 
@@ -340,6 +341,7 @@ fn run_pattern(args: PatternArgs, quiet: bool, verbose: bool) -> Result<(), Fail
         args.out.preview.as_deref(),
         quiet,
         &job,
+        None,
     )
 }
 
@@ -379,6 +381,7 @@ fn run_fill(args: FillArgs, quiet: bool, verbose: bool) -> Result<(), Failure> {
         args.out.preview.as_deref(),
         quiet,
         &job,
+        None,
     )
 }
 
@@ -465,7 +468,7 @@ fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
                 suffixed(p)
             }
         });
-        run_variant(
+        run_jobs(
             &args.sketches,
             output.as_deref(),
             args.out.out_dir.as_deref(),
@@ -478,20 +481,11 @@ fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
     Ok(())
 }
 
+/// Runs `job` on every input and writes its SVG (and preview) where the
+/// output options say, in parallel with a progress bar. For one variation
+/// `k` (1-based) of several, `--out-dir` files are named `NAME-vK.svg` /
+/// `NAME-vK.png`.
 fn run_jobs(
-    inputs: &[PathBuf],
-    output: Option<&Path>,
-    out_dir: Option<&Path>,
-    preview: Option<&Path>,
-    quiet: bool,
-    job: &(dyn Fn(&Path) -> Result<String, Error> + Sync),
-) -> Result<(), Failure> {
-    run_variant(inputs, output, out_dir, preview, quiet, job, None)
-}
-
-/// [`run_jobs`] for one variation `k` (1-based) of several: with
-/// `--out-dir` the files are named `NAME-vK.svg` / `NAME-vK.png`.
-fn run_variant(
     inputs: &[PathBuf],
     output: Option<&Path>,
     out_dir: Option<&Path>,
