@@ -73,11 +73,17 @@ pub fn boundary_field(
     let mut wt = Grid::new(width, height, 0.0f32);
     let mut mean = Vec2::ZERO;
     for s in boundary {
+        // A sample on the grid's far edge (x = width) belongs to the last
+        // pixel, not outside: an outline drawn along the canvas edge keeps
+        // its direction there.
         let (x, y) = (s.at.x.floor(), s.at.y.floor());
-        if x < 0.0 || y < 0.0 || x >= width as f64 || y >= height as f64 {
+        if width == 0 || height == 0 || !(x >= 0.0 && y >= 0.0) {
             continue;
         }
-        let (x, y) = (x as usize, y as usize);
+        if x > width as f64 || y > height as f64 {
+            continue;
+        }
+        let (x, y) = ((x as usize).min(width - 1), (y as usize).min(height - 1));
         vx.set(x, y, vx.get(x, y) + (s.dir.x * s.len) as f32);
         vy.set(x, y, vy.get(x, y) + (s.dir.y * s.len) as f32);
         wt.set(x, y, wt.get(x, y) + s.len as f32);
@@ -249,6 +255,28 @@ mod tests {
             let t = Vec2::new(-a.sin(), a.cos());
             assert!(d[0] as f64 * t.x + d[1] as f64 * t.y > 0.95, "{k}: {d:?}");
         }
+    }
+
+    /// A rectangle drawn exactly on the canvas edges: the right and bottom
+    /// sides lie on x = width and y = height and still steer the field
+    /// next to them.
+    #[test]
+    fn an_outline_on_the_far_canvas_edges_counts() {
+        let (w, h) = (40usize, 30usize);
+        let pts = [
+            Point::new(0.0, 0.0),
+            Point::new(w as f64, 0.0),
+            Point::new(w as f64, h as f64),
+            Point::new(0.0, h as f64),
+            Point::new(0.0, 0.0),
+        ];
+        let f = boundary_field(w, h, &sample_polyline(&pts, 0.5), 3.0);
+        // Next to the right side the flow runs down it (+y), next to the
+        // bottom one along it (−x), as the outline does.
+        let right = f.get(w - 1, h / 2);
+        assert!(right[1] > 0.9, "right edge {right:?}");
+        let bottom = f.get(w / 2, h - 1);
+        assert!(bottom[0] < -0.9, "bottom edge {bottom:?}");
     }
 
     #[test]
