@@ -110,8 +110,19 @@ fn smooth_loop(path: &[Point]) -> SmoothLoop {
     if n < 4 {
         return polyline_loop(path);
     }
-    let lon = straight_runs(path);
-    let poly = optimal_polygon(&lon, n);
+    // Runs are computed only where the polygon search lands (memoized): a
+    // greedy cover visits a few vertices per run length, not all of them.
+    let runs = Runs::new(path);
+    let mut memo = vec![0usize; n];
+    let poly = optimal_polygon(
+        |i| {
+            if memo[i] == 0 {
+                memo[i] = runs.from(i);
+            }
+            memo[i]
+        },
+        n,
+    );
     if poly.len() < 3 {
         return polyline_loop(path);
     }
@@ -151,85 +162,112 @@ fn unit(v: Vec2) -> Vec2 {
 /// advancing. So the walk jumps from stretch end to stretch end and only
 /// steps vertex by vertex through the stretch where the run ends. The
 /// result is the same as [`run_from`] applied at every vertex (tested).
+#[cfg(test)]
 fn straight_runs(path: &[Point]) -> Vec<usize> {
-    let n = path.len();
-    let steps = path_steps(path);
-    // stretch_end[k]: the last vertex reached by repeating the step into
-    // vertex k + 1 (as an offset from k, at least 1).
-    let mut stretch = vec![1usize; n];
-    if n >= 3 {
-        let same = |k: usize| steps[(k + 1) % n].0 == steps[k].0;
-        // Walk backwards twice around the loop so the wrap is settled.
-        let mut len_after = vec![0usize; n]; // repeats of step k+1 after it
-        for pass in 0..2 {
-            for k in (0..n).rev() {
-                let next = (k + 1) % n;
-                let v = if same(next) {
-                    (len_after[next] + 1).min(n - 1)
-                } else {
-                    0
-                };
-                if pass == 1 || v > len_after[k] {
-                    len_after[k] = v;
+    let runs = Runs::new(path);
+    (0..path.len())
+        .into_par_iter()
+        .map(|i| runs.from(i))
+        .collect()
+}
+
+/// What the straight-run walk needs of a path, computed once: its steps and
+/// how far each step repeats. [`Runs::from`] is then one vertex's run, so
+/// the polygon search (step 3) computes runs only at the vertices it visits.
+struct Runs<'a> {
+    path: &'a [Point],
+    steps: Vec<(Vec2, f64)>,
+    /// `stretch[k]`: how many vertices ahead of `k` the step into `k + 1`
+    /// keeps repeating (at least 1).
+    stretch: Vec<usize>,
+}
+
+impl<'a> Runs<'a> {
+    fn new(path: &'a [Point]) -> Self {
+        let n = path.len();
+        let steps = path_steps(path);
+        let mut stretch = vec![1usize; n];
+        if n >= 3 {
+            let same = |k: usize| steps[(k + 1) % n].0 == steps[k].0;
+            // Walk backwards twice around the loop so the wrap is settled.
+            let mut len_after = vec![0usize; n]; // repeats of step k+1 after it
+            for pass in 0..2 {
+                for k in (0..n).rev() {
+                    let next = (k + 1) % n;
+                    let v = if same(next) {
+                        (len_after[next] + 1).min(n - 1)
+                    } else {
+                        0
+                    };
+                    if pass == 1 || v > len_after[k] {
+                        len_after[k] = v;
+                    }
                 }
             }
+            for k in 0..n {
+                stretch[k] = len_after[k] + 1;
+            }
         }
-        for k in 0..n {
-            stretch[k] = len_after[k] + 1;
+        Runs {
+            path,
+            steps,
+            stretch,
         }
     }
-    let limit = n.min(MAX_RUN);
-    (0..n)
-        .into_par_iter()
-        .map(|i| {
-            let mut run = Run::new(path[i]);
-            let mut j = i;
-            let mut m = 0usize;
-            loop {
-                let ahead = stretch[j];
-                let e = (j + ahead) % n;
-                if ahead >= 2 && m + ahead < limit {
-                    // The stretch's first step must advance, and its end
-                    // must pass; then every vertex between passes too.
-                    let first = (j + 1) % n;
-                    if !run.advances(path[first], steps[first]) {
-                        break;
-                    }
-                    if run.admits(path[e]) {
-                        m += ahead;
-                        j = e;
-                        if !run.take(path[e]) {
-                            break;
-                        }
-                        continue;
-                    }
+
+    /// `lon[i]`: how many vertices ahead of `i` the straight run from `i`
+    /// reaches (at least 1).
+    fn from(&self, i: usize) -> usize {
+        let (path, steps, stretch) = (self.path, &self.steps, &self.stretch);
+        let n = path.len();
+        let limit = n.min(MAX_RUN);
+        let mut run = Run::new(path[i]);
+        let mut j = i;
+        let mut m = 0usize;
+        loop {
+            let ahead = stretch[j];
+            let e = (j + ahead) % n;
+            if ahead >= 2 && m + ahead < limit {
+                // The stretch's first step must advance, and its end must
+                // pass; then every vertex between passes too.
+                let first = (j + 1) % n;
+                if !run.advances(path[first], steps[first]) {
+                    break;
                 }
-                // Vertex by vertex to the end of the stretch (or the cap).
-                let mut ended = false;
-                for _ in 0..ahead {
-                    if m + 1 >= limit {
-                        ended = true;
+                if run.admits(path[e]) {
+                    m += ahead;
+                    j = e;
+                    if !run.take(path[e]) {
                         break;
                     }
-                    let k = (j + 1) % n;
-                    if !(run.advances(path[k], steps[k]) && run.admits(path[k])) {
-                        ended = true;
-                        break;
-                    }
-                    m += 1;
-                    j = k;
-                    if !run.take(path[k]) {
-                        ended = true;
-                        break;
-                    }
+                    continue;
                 }
-                if ended {
+            }
+            // Vertex by vertex to the end of the stretch (or the cap).
+            let mut ended = false;
+            for _ in 0..ahead {
+                if m + 1 >= limit {
+                    ended = true;
+                    break;
+                }
+                let k = (j + 1) % n;
+                if !(run.advances(path[k], steps[k]) && run.admits(path[k])) {
+                    ended = true;
+                    break;
+                }
+                m += 1;
+                j = k;
+                if !run.take(path[k]) {
+                    ended = true;
                     break;
                 }
             }
-            m.max(1)
-        })
-        .collect()
+            if ended {
+                break;
+            }
+        }
+        m.max(1)
+    }
 }
 
 /// Each step of a closed path (from vertex k − 1 to vertex k) and its
@@ -343,13 +381,13 @@ fn run_from(path: &[Point], i: usize) -> usize {
 }
 
 /// Step 3: the polygon with fewest straight edges, as path indices in order.
-fn optimal_polygon(lon: &[usize], n: usize) -> Vec<usize> {
-    let cover = |start: usize| -> Vec<usize> {
+fn optimal_polygon(mut lon: impl FnMut(usize) -> usize, n: usize) -> Vec<usize> {
+    let mut cover = |start: usize| -> Vec<usize> {
         let mut out = vec![start];
         let mut at = 0usize; // steps from start
         while at < n {
             let i = (start + at) % n;
-            let step = lon[i].max(1);
+            let step = lon(i).max(1);
             at += step;
             if at >= n {
                 break;
@@ -875,7 +913,7 @@ mod tests {
             }
         }
         // The polygon needs far fewer vertices than the path.
-        let poly = optimal_polygon(&lon, n);
+        let poly = optimal_polygon(|i| lon[i], n);
         assert!(poly.len() * 5 <= n, "{} vertices of {n}", poly.len());
         // And the smoothed outline stays within half a pixel (plus the
         // rounding of the band's four corners) of the drawn band's edges.
