@@ -283,15 +283,7 @@ fn run_trace(args: TraceArgs, quiet: bool) -> Result<(), Failure> {
     let job = |inp: &Path| -> Result<String, Error> {
         Ok(trace::trace_file(inp, &input, &opts)?.to_svg())
     };
-    run_jobs(
-        &args.inputs,
-        args.out.output.as_deref(),
-        args.out.out_dir.as_deref(),
-        args.out.preview.as_deref(),
-        quiet,
-        &job,
-        None,
-    )
+    run_batch(&args.inputs, &args.out, quiet, &job)
 }
 
 /// Reads a sketch and reports what it skipped: warnings unless `quiet`,
@@ -334,15 +326,7 @@ fn run_pattern(args: PatternArgs, quiet: bool, verbose: bool) -> Result<(), Fail
             .to_document()
             .to_svg())
     };
-    run_jobs(
-        &args.sketches,
-        args.out.output.as_deref(),
-        args.out.out_dir.as_deref(),
-        args.out.preview.as_deref(),
-        quiet,
-        &job,
-        None,
-    )
+    run_batch(&args.sketches, &args.out, quiet, &job)
 }
 
 fn run_fill(args: FillArgs, quiet: bool, verbose: bool) -> Result<(), Failure> {
@@ -374,19 +358,9 @@ fn run_fill(args: FillArgs, quiet: bool, verbose: bool) -> Result<(), Failure> {
         }
         Ok(out.to_document().to_svg())
     };
-    run_jobs(
-        &args.sketches,
-        args.out.output.as_deref(),
-        args.out.out_dir.as_deref(),
-        args.out.preview.as_deref(),
-        quiet,
-        &job,
-        None,
-    )
+    run_batch(&args.sketches, &args.out, quiet, &job)
 }
 
-/// Runs `job` on one input (`-o`) or a batch (`--out-dir`, in parallel with
-/// a progress bar), writing each SVG and optional preview atomically.
 fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure> {
     use flourish::brush::{output::brush_sketch, pipeline::BrushOptions};
     use flourish::style::brush::{AnalysisOptions, BrushStyle};
@@ -479,6 +453,24 @@ fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
         )?;
     }
     Ok(())
+}
+
+/// [`run_jobs`] with the output options as given (no variation suffix).
+fn run_batch(
+    inputs: &[PathBuf],
+    out: &Outputs,
+    quiet: bool,
+    job: &(dyn Fn(&Path) -> Result<String, Error> + Sync),
+) -> Result<(), Failure> {
+    run_jobs(
+        inputs,
+        out.output.as_deref(),
+        out.out_dir.as_deref(),
+        out.preview.as_deref(),
+        quiet,
+        job,
+        None,
+    )
 }
 
 /// Runs `job` on every input and writes its SVG (and preview) where the

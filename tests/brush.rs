@@ -4,6 +4,7 @@
 //! `golden/.failed/`), path-fidelity and structure quality checks, the
 //! comparison with the art-brush baseline, determinism, and bad input.
 
+mod golden_file;
 use flourish::brush::output::{
     brush_sketch, components, final_layers, smallest_exemplar_component,
 };
@@ -57,14 +58,9 @@ fn sketch(name: &str) -> flourish::sketch::Sketch {
 }
 
 fn check_golden(name: &str, actual: &str) {
-    let path = root().join("golden/brush").join(name);
-    if std::env::var_os("UPDATE_GOLDEN").is_some() {
-        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
-        std::fs::write(&path, actual).unwrap();
+    let Some(expected) = golden_file::expected("brush", name, actual) else {
         return;
-    }
-    let expected = std::fs::read_to_string(&path)
-        .unwrap_or_else(|e| panic!("{}: {e}; run with UPDATE_GOLDEN=1", path.display()));
+    };
     if expected != actual {
         let failed = root().join("golden/.failed");
         std::fs::create_dir_all(&failed).unwrap();

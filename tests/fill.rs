@@ -5,6 +5,7 @@
 //! file stays fast. `UPDATE_GOLDEN=1 cargo test --test fill` rewrites
 //! `golden/fill/`.
 
+mod golden_file;
 use flourish::field::diffusion::constant_field;
 use flourish::fill::tile::{SourceDirection, Tile};
 use flourish::fill::{em, fill_sketch, FillOptions, FillOutput};
@@ -267,18 +268,12 @@ fn bad_inputs_fail_with_one_clear_line() {
 
 /// Compares with the golden file byte for byte; `UPDATE_GOLDEN=1` rewrites.
 fn check_golden(name: &str, actual: &str) {
-    let path = root().join("golden/fill").join(name);
-    if std::env::var_os("UPDATE_GOLDEN").is_some() {
-        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
-        std::fs::write(&path, actual).unwrap();
+    let Some(expected) = golden_file::expected("fill", name, actual) else {
         return;
-    }
-    let expected = std::fs::read_to_string(&path)
-        .unwrap_or_else(|e| panic!("{}: {e}; run with UPDATE_GOLDEN=1", path.display()));
+    };
     assert!(
         expected == actual,
-        "{} differs; run with UPDATE_GOLDEN=1 and review",
-        path.display()
+        "golden/fill/{name} differs; run with UPDATE_GOLDEN=1 and review"
     );
 }
 

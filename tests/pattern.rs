@@ -3,6 +3,7 @@
 //!
 //! `UPDATE_GOLDEN=1 cargo test --test pattern` rewrites `golden/pattern/`.
 
+mod golden_file;
 use flourish::pattern::element::load_example;
 use flourish::pattern::seeds::{self, Region};
 use flourish::pattern::{cluster, PatternOptions, PatternStyle};
@@ -555,14 +556,9 @@ fn bad_input_gives_one_clear_line() {
 /// Compares `actual` with the golden file, numbers to ±0.002 (libm may
 /// differ in the last bits across machines); `UPDATE_GOLDEN=1` rewrites it.
 fn check_golden(name: &str, actual: &str) {
-    let path = root().join("golden/pattern").join(name);
-    if std::env::var_os("UPDATE_GOLDEN").is_some() {
-        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
-        std::fs::write(&path, actual).unwrap();
+    let Some(expected) = golden_file::expected("pattern", name, actual) else {
         return;
-    }
-    let expected = std::fs::read_to_string(&path)
-        .unwrap_or_else(|e| panic!("{}: {e}; run with UPDATE_GOLDEN=1", path.display()));
+    };
     if expected == actual {
         return;
     }
