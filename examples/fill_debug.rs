@@ -43,15 +43,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (outline, rule) = sk
         .queries
         .iter()
-        .find_map(|q| match &q.kind {
-            QueryKind::Region { outline, fill_rule } => Some((outline.clone(), *fill_rule)),
-            _ => None,
-        })
+        .find_map(|q| q.region())
         .ok_or("no region")?;
     let mut region = Region::rasterize(
         &sk.path,
         "r",
-        &outline,
+        outline,
         rule,
         st.px_per_unit(),
         params.radius + 2,

@@ -303,6 +303,12 @@ fn load_sketch(path: &Path, quiet: bool, verbose: bool) -> Result<flourish::sket
     Ok(sk)
 }
 
+/// The `--styles` folder, or the default styles folder.
+fn styles_dir(arg: &Option<PathBuf>) -> PathBuf {
+    arg.clone()
+        .unwrap_or_else(flourish::style::default_styles_dir)
+}
+
 fn run_pattern(args: PatternArgs, quiet: bool, verbose: bool) -> Result<(), Failure> {
     if !(args.variation.is_finite() && (0.0..=1.0).contains(&args.variation)) {
         return Err(Failure::Usage(format!(
@@ -312,10 +318,7 @@ fn run_pattern(args: PatternArgs, quiet: bool, verbose: bool) -> Result<(), Fail
     }
     let opts = PatternOptions {
         style: args.style.clone(),
-        styles_dir: args
-            .styles
-            .clone()
-            .unwrap_or_else(flourish::style::default_styles_dir),
+        styles_dir: styles_dir(&args.styles),
         seed: args.out.seed,
         variation: args.variation,
         ..PatternOptions::default()
@@ -339,10 +342,7 @@ fn run_fill(args: FillArgs, quiet: bool, verbose: bool) -> Result<(), Failure> {
     }
     let opts = FillOptions {
         style: args.style.clone(),
-        styles_dir: args
-            .styles
-            .clone()
-            .unwrap_or_else(flourish::style::default_styles_dir),
+        styles_dir: styles_dir(&args.styles),
         seed: args.out.seed,
         direction: args.direction.clone(),
         resolution: args.resolution,
@@ -375,10 +375,7 @@ fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
             "--variations needs -o OUT.svg (a file) or --out-dir DIR".into(),
         ));
     }
-    let styles = args
-        .styles
-        .clone()
-        .unwrap_or_else(flourish::style::default_styles_dir);
+    let styles = styles_dir(&args.styles);
     let dir = flourish::style::resolve(&args.style, &styles)?;
     let analysis = AnalysisOptions {
         cache_dir: args.cache.clone(),

@@ -56,6 +56,17 @@ pub struct Query {
     pub kind: QueryKind,
 }
 
+impl Query {
+    /// The outline (user units) and fill rule of a region query; `None`
+    /// for an open path.
+    pub fn region(&self) -> Option<(&BezPath, FillRule)> {
+        match &self.kind {
+            QueryKind::Region { outline, fill_rule } => Some((outline, *fill_rule)),
+            QueryKind::Path { .. } => None,
+        }
+    }
+}
+
 /// A parsed sketch.
 #[derive(Clone, Debug)]
 pub struct Sketch {
@@ -112,14 +123,7 @@ pub fn parse(path: &Path, data: &[u8]) -> Result<Sketch> {
 /// Converts a tiny-skia path under transform `ts` into a kurbo path.
 pub fn to_bezpath(path: &usvg::tiny_skia_path::Path, ts: usvg::Transform) -> BezPath {
     use usvg::tiny_skia_path::PathSegment;
-    let affine = Affine::new([
-        ts.sx as f64,
-        ts.ky as f64,
-        ts.kx as f64,
-        ts.sy as f64,
-        ts.tx as f64,
-        ts.ty as f64,
-    ]);
+    let affine = affine_of(ts);
     let p = |q: usvg::tiny_skia_path::Point| affine * kurbo::Point::new(q.x as f64, q.y as f64);
     let mut out = BezPath::new();
     for seg in path.segments() {

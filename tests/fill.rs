@@ -9,7 +9,7 @@ mod golden_file;
 use flourish::field::diffusion::constant_field;
 use flourish::fill::tile::{SourceDirection, Tile};
 use flourish::fill::{em, fill_sketch, FillOptions, FillOutput};
-use flourish::sketch::{self, QueryKind};
+use flourish::sketch;
 use flourish::svg_out::FillRule;
 use kurbo::{BezPath, Line, ParamCurve, PathSeg, Point, Shape as _};
 use std::path::{Path, PathBuf};
@@ -64,20 +64,19 @@ fn inside(outline: &BezPath, rule: FillRule, p: Point) -> bool {
     }
 }
 
+/// The sketch's first region query: its outline (user units) and fill rule.
+fn first_region(sk: &sketch::Sketch) -> (BezPath, FillRule) {
+    let (outline, rule) = sk.queries.iter().find_map(|q| q.region()).unwrap();
+    (outline.clone(), rule)
+}
+
 #[test]
 fn ink_fraction_and_containment_per_region() {
     for style in ["knot", "scales"] {
         for name in ["circle", "star", "letter", "frame"] {
             let out = run_full(style, name);
             let sk = sketch::load(&sample(name)).unwrap();
-            let (outline, rule) = sk
-                .queries
-                .iter()
-                .find_map(|q| match &q.kind {
-                    QueryKind::Region { outline, fill_rule } => Some((outline.clone(), *fill_rule)),
-                    _ => None,
-                })
-                .unwrap();
+            let (outline, rule) = first_region(&sk);
             assert_eq!(out.regions.len(), 1);
             let r = &out.regions[0];
             let (f, t) = (r.ink_fraction(), r.tile_ink);
@@ -454,14 +453,7 @@ fn the_knot_stays_continuous_under_constant_turning_and_ring_fields() {
 fn knot_circle() -> (flourish::fill::FillStyle, flourish::fill::region::Region) {
     let style = flourish::fill::FillStyle::load(&root().join("styles/knot"), None).unwrap();
     let sk = sketch::load(&sample("circle")).unwrap();
-    let (outline, rule) = sk
-        .queries
-        .iter()
-        .find_map(|q| match &q.kind {
-            QueryKind::Region { outline, fill_rule } => Some((outline.clone(), *fill_rule)),
-            _ => None,
-        })
-        .unwrap();
+    let (outline, rule) = first_region(&sk);
     let region = flourish::fill::region::Region::rasterize(
         &sk.path,
         "circle",

@@ -88,13 +88,7 @@ fn clustering_groups_a_flower_and_keeps_distant_hatches_apart() {
 }
 
 fn unit_square(s: f64) -> BezPath {
-    let mut p = BezPath::new();
-    p.move_to((0.0, 0.0));
-    p.line_to((s, 0.0));
-    p.line_to((s, s));
-    p.line_to((0.0, s));
-    p.close_path();
-    p
+    kurbo::Rect::new(0.0, 0.0, s, s).to_path(0.1)
 }
 
 #[test]

@@ -369,20 +369,52 @@ impl<'a> Problem<'a> {
 
     /// Recomputes every match's cost against the current target.
     pub fn refresh(&self, nnf: &mut Nnf) {
-        let costs: Vec<f32> = (0..nnf.matches.len())
+        nnf.matches = self.each_active(nnf, &nnf.matches, |buf, _k, (qx, qy), m| {
+            self.target_patch(qx, qy, buf);
+            Match {
+                cost: self.distance(buf, qx, qy, m.x as usize, m.y as usize, f32::INFINITY),
+                ..m
+            }
+        });
+    }
+
+    /// Maps every active match through `step` in parallel, in index order
+    /// (so the result does not depend on the thread count); inactive
+    /// matches are kept. `step` gets a reusable patch buffer, the match's
+    /// index, its centre on the target (px) and the match.
+    fn each_active<F>(&self, shape: &Nnf, matches: &[Match], step: F) -> Vec<Match>
+    where
+        F: Fn(&mut Vec<f32>, usize, (usize, usize), Match) -> Match + Sync,
+    {
+        (0..matches.len())
             .into_par_iter()
             .map_init(Vec::new, |buf, k| {
-                let m = nnf.matches[k];
-                if !self.is_active(k) {
-                    return m.cost;
+                let m = matches[k];
+                if self.is_active(k) {
+                    step(buf, k, shape.centre(k), m)
+                } else {
+                    m
                 }
-                let (qx, qy) = nnf.centre(k);
-                self.target_patch(qx, qy, buf);
-                self.distance(buf, qx, qy, m.x as usize, m.y as usize, f32::INFINITY)
             })
-            .collect();
-        for (m, c) in nnf.matches.iter_mut().zip(costs) {
-            m.cost = c;
+            .collect()
+    }
+
+    /// Replaces `best` by tile pixel `(px, py)` when that patch is closer
+    /// to the gathered target patch `tp` centred at `(qx, qy)`.
+    fn try_candidate(
+        &self,
+        tp: &[f32],
+        (qx, qy): (usize, usize),
+        (px, py): (usize, usize),
+        best: &mut Match,
+    ) {
+        let c = self.distance(tp, qx, qy, px, py, best.cost);
+        if c < best.cost {
+            *best = Match {
+                x: px as u32,
+                y: py as u32,
+                cost: c,
+            };
         }
     }
 
@@ -390,92 +422,54 @@ impl<'a> Problem<'a> {
     /// Costs must be current (see [`Problem::refresh`]).
     pub fn improve(&self, nnf: &mut Nnf, seed: u64, round: u64) {
         let (sw, sh) = (self.source.width, self.source.height);
-        let start = Nnf {
-            matches: std::mem::take(&mut nnf.matches),
-            ..*nnf
-        };
         // Random search (CaTS Alg. 5, windows halving from the tile size).
-        nnf.matches = (0..start.matches.len())
-            .into_par_iter()
-            .map_init(Vec::new, |buf, k| {
-                let mut best = start.matches[k];
-                if !self.is_active(k) {
-                    return best;
-                }
-                let (qx, qy) = start.centre(k);
-                self.target_patch(qx, qy, buf);
-                let mut radius = sw.max(sh) as i64 / 2;
-                let mut i = 0u64;
-                while radius >= 1 {
-                    let span = 2 * radius as usize + 1;
-                    let draw =
-                        |axis| rng::index(&[seed, round, k as u64, i, axis], span) as i64 - radius;
-                    let (ox, oy) = (draw(0), draw(1));
-                    let (px, py) = self.wrap(best.x as i64 + ox, best.y as i64 + oy);
-                    let c = self.distance(buf, qx, qy, px, py, best.cost);
-                    if c < best.cost {
-                        best = Match {
-                            x: px as u32,
-                            y: py as u32,
-                            cost: c,
-                        };
-                    }
-                    radius /= 2;
-                    i += 1;
-                }
-                best
-            })
-            .collect();
+        nnf.matches = self.each_active(nnf, &nnf.matches, |buf, k, q, mut best| {
+            self.target_patch(q.0, q.1, buf);
+            let mut radius = sw.max(sh) as i64 / 2;
+            let mut i = 0u64;
+            while radius >= 1 {
+                let span = 2 * radius as usize + 1;
+                let draw =
+                    |axis| rng::index(&[seed, round, k as u64, i, axis], span) as i64 - radius;
+                let (ox, oy) = (draw(0), draw(1));
+                let p = self.wrap(best.x as i64 + ox, best.y as i64 + oy);
+                self.try_candidate(buf, q, p, &mut best);
+                radius /= 2;
+                i += 1;
+            }
+            best
+        });
         // Propagation by jump flooding (CaTS Alg. 6).
         for step in [4usize, 2, 1] {
-            let prev = Nnf {
-                matches: std::mem::take(&mut nnf.matches),
-                ..*nnf
-            };
-            nnf.matches = (0..prev.matches.len())
-                .into_par_iter()
-                .map_init(Vec::new, |buf, k| {
-                    let mut best = prev.matches[k];
-                    if !self.is_active(k) {
-                        return best;
+            nnf.matches = self.each_active(nnf, &nnf.matches, |buf, k, q, mut best| {
+                let (i, j) = (k % nnf.cols, k / nnf.cols);
+                let mut gathered = false;
+                let neighbours = [
+                    (i.checked_sub(step), Some(j)),
+                    (Some(i + step).filter(|&v| v < nnf.cols), Some(j)),
+                    (Some(i), j.checked_sub(step)),
+                    (Some(i), Some(j + step).filter(|&v| v < nnf.rows)),
+                ];
+                for (ni, nj) in neighbours {
+                    let (Some(ni), Some(nj)) = (ni, nj) else {
+                        continue;
+                    };
+                    let n = nnf.matches[nj * nnf.cols + ni];
+                    let (nx, ny) = (ni * nnf.spacing, nj * nnf.spacing);
+                    let dx = q.0 as i32 - nx as i32;
+                    let dy = q.1 as i32 - ny as i32;
+                    let p = self.map(nx, ny, n.x as usize, n.y as usize, dx, dy);
+                    if p == (best.x as usize, best.y as usize) {
+                        continue;
                     }
-                    let (i, j) = (k % prev.cols, k / prev.cols);
-                    let (qx, qy) = prev.centre(k);
-                    let mut gathered = false;
-                    let neighbours = [
-                        (i.checked_sub(step), Some(j)),
-                        (Some(i + step).filter(|&v| v < prev.cols), Some(j)),
-                        (Some(i), j.checked_sub(step)),
-                        (Some(i), Some(j + step).filter(|&v| v < prev.rows)),
-                    ];
-                    for (ni, nj) in neighbours {
-                        let (Some(ni), Some(nj)) = (ni, nj) else {
-                            continue;
-                        };
-                        let n = prev.matches[nj * prev.cols + ni];
-                        let (nx, ny) = (ni * prev.spacing, nj * prev.spacing);
-                        let dx = qx as i32 - nx as i32;
-                        let dy = qy as i32 - ny as i32;
-                        let (px, py) = self.map(nx, ny, n.x as usize, n.y as usize, dx, dy);
-                        if px == best.x as usize && py == best.y as usize {
-                            continue;
-                        }
-                        if !gathered {
-                            self.target_patch(qx, qy, buf);
-                            gathered = true;
-                        }
-                        let c = self.distance(buf, qx, qy, px, py, best.cost);
-                        if c < best.cost {
-                            best = Match {
-                                x: px as u32,
-                                y: py as u32,
-                                cost: c,
-                            };
-                        }
+                    if !gathered {
+                        self.target_patch(q.0, q.1, buf);
+                        gathered = true;
                     }
-                    best
-                })
-                .collect();
+                    self.try_candidate(buf, q, p, &mut best);
+                }
+                best
+            });
         }
     }
 
@@ -491,14 +485,7 @@ impl<'a> Problem<'a> {
         };
         for py in 0..self.source.height {
             for px in 0..self.source.width {
-                let c = self.distance(&buf, qx, qy, px, py, f32::INFINITY);
-                if c < best.cost {
-                    best = Match {
-                        x: px as u32,
-                        y: py as u32,
-                        cost: c,
-                    };
-                }
+                self.try_candidate(&buf, (qx, qy), (px, py), &mut best);
             }
         }
         best

@@ -633,13 +633,7 @@ mod tests {
     use super::*;
 
     fn square(s: f64) -> BezPath {
-        let mut p = BezPath::new();
-        p.move_to((0.0, 0.0));
-        p.line_to((s, 0.0));
-        p.line_to((s, s));
-        p.line_to((0.0, s));
-        p.close_path();
-        p
+        kurbo::Shape::to_path(&kurbo::Rect::new(0.0, 0.0, s, s), 0.1)
     }
 
     #[test]
