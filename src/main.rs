@@ -88,7 +88,7 @@ struct Outputs {
     /// Output SVG (`-` for standard output); one input only.
     #[arg(short = 'o', long = "output", value_name = "OUT.svg")]
     output: Option<PathBuf>,
-    /// Output folder for a batch: NAME.svg per input.
+    /// Output folder for a batch (made if missing): NAME.svg per input.
     #[arg(long, value_name = "DIR", conflicts_with = "output")]
     out_dir: Option<PathBuf>,
     /// Render the result to a PNG (with --out-dir: a folder for NAME.png).
@@ -303,6 +303,26 @@ fn load_sketch(path: &Path, quiet: bool, verbose: bool) -> Result<flourish::sket
     Ok(sk)
 }
 
+/// Makes output folder `dir` (and its parents) unless it exists; a file
+/// in its place is an error.
+fn make_folder(dir: &Path) -> Result<(), Failure> {
+    if dir.is_dir() {
+        return Ok(());
+    }
+    if dir.exists() {
+        return Err(Failure::Run(Error::invalid(
+            dir,
+            "is not a folder (--out-dir and, with it, --preview name folders)",
+        )));
+    }
+    std::fs::create_dir_all(dir).map_err(|e| {
+        Failure::Run(Error::invalid(
+            dir,
+            format!("cannot make the output folder: {e}"),
+        ))
+    })
+}
+
 /// The `--styles` folder, or the default styles folder.
 fn styles_dir(arg: &Option<PathBuf>) -> PathBuf {
     arg.clone()
@@ -505,19 +525,10 @@ fn run_jobs(
             Ok(())
         }
         (None, Some(dir)) => {
-            if !dir.is_dir() {
-                return Err(Failure::Run(Error::invalid(
-                    dir,
-                    "output folder does not exist",
-                )));
-            }
+            // Output folders are made as needed, like `mkdir -p`.
+            make_folder(dir)?;
             if let Some(p) = preview {
-                if !p.is_dir() {
-                    return Err(Failure::Run(Error::invalid(
-                        p,
-                        "with --out-dir, --preview names an existing folder",
-                    )));
-                }
+                make_folder(p)?;
             }
             let mut names = std::collections::BTreeSet::new();
             for inp in inputs {

@@ -827,15 +827,32 @@ fn out_dir_batch_with_missing_input_writes_the_others() {
     assert!(!outdir.join("missing.svg").exists());
 }
 
+/// A missing `--out-dir` (and `--preview` folder) is made, parents
+/// included, like `mkdir -p`; a file in its place is an error that
+/// leaves the file alone.
 #[test]
-fn out_dir_must_exist() {
+fn out_dir_is_made_when_missing_and_a_file_there_is_an_error() {
     let t = tempdir();
     let a = t.path().join("a.png");
     write_disc_png(&a, 16);
-    let outdir = t.path().join("nowhere");
-    let o = flourish(&["trace", s(&a), "--out-dir", s(&outdir)]);
-    assert_failure(&o, &outdir, &[]);
-    assert!(!outdir.exists());
+    let outdir = t.path().join("new/svg");
+    let previews = t.path().join("new/png");
+    let o = flourish(&[
+        "trace",
+        s(&a),
+        "--out-dir",
+        s(&outdir),
+        "--preview",
+        s(&previews),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(outdir.join("a.svg").is_file());
+    assert!(previews.join("a.png").is_file());
+    let file = t.path().join("taken");
+    std::fs::write(&file, "keep").unwrap();
+    let o = flourish(&["trace", s(&a), "--out-dir", s(&file)]);
+    assert_failure(&o, &file, &[]);
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "keep");
 }
 
 #[test]
