@@ -148,25 +148,32 @@ fn main() -> std::io::Result<()> {
     // turned both families into spirals whose spacing must change with the
     // radius, and the weave tore everywhere; along one family, that family
     // becomes unbroken rings and only the other (the spokes) must end.
-    for (name, tile, dir, says) in [
+    // The flow is what that direction follows in a shape no stroke combs:
+    // the knot's bands read the same turned by 180° and follow the
+    // outline's flow, rings and all; the scales have one "up" and cannot
+    // follow the vortex that the flow of a closed outline turns around, so
+    // their rows run straight across unless strokes comb them.
+    for (name, tile, dir, says, flow) in [
         (
             "knot",
             knot(),
             "[1.0, -1.0]",
             "The bands rising to the right follow the region's direction field.",
+            "# The field follows the shape's outline where no stroke combs it.\nflow = \"outline\"",
         ),
         (
             "scales",
             scales(),
             "[1.0, 0.0]",
             "The rows of scales (the tile's x axis) follow the region's direction field.",
+            "# Where no stroke combs the shape, the rows run along the sketch's x axis:\n# scales have one \"up\" and cannot follow an outline's flow around a vortex.\nflow = [1.0, 0.0]",
         ),
     ] {
         write(&root.join(format!("styles/{name}/tile.svg")), &tile)?;
         write(
             &root.join(format!("styles/{name}/style.toml")),
             &format!(
-                "# Fill style drawn by examples/make_fill_styles.rs: a seamless {T}×{T} tile.\nkind = \"fill\"\n# Tile pixels on its longest side (1 px per tile unit).\nresolution = 96\n# Sketch units per tile unit.\nscale = 1.0\n# {says}\ndirection = {dir}\npatch = 9\nlevels = 2\niterations = 4\n\n[[exemplar]]\nfile = \"tile.svg\"\n"
+                "# Fill style drawn by examples/make_fill_styles.rs: a seamless {T}×{T} tile.\nkind = \"fill\"\n# Tile pixels on its longest side (1 px per tile unit).\nresolution = 96\n# Sketch units per tile unit.\nscale = 1.0\n# {says}\ndirection = {dir}\n{flow}\npatch = 9\nlevels = 2\niterations = 4\n\n[[exemplar]]\nfile = \"tile.svg\"\n"
             ),
         )?;
     }

@@ -43,6 +43,7 @@ pub mod shape;
 pub mod tile;
 
 use crate::error::{Error, Result};
+use crate::field::diffusion::constant_field;
 use crate::raster::{Grid, Sdf};
 use crate::sketch::{self, QueryKind, Sketch};
 use crate::style::{self, DirectionToml, StyleKind};
@@ -97,6 +98,17 @@ pub struct FillStyle {
     pub params: EmParams,
     /// Sketch units per tile user unit.
     pub scale: f64,
+    /// What the tile's direction follows where no stroke combs the shape.
+    pub flow: Flow,
+}
+
+/// A fill style's uncombed target field (the style's `flow` key).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Flow {
+    /// The outline's flow diffused inwards (Brushables §3.1).
+    Outline,
+    /// One direction everywhere, `[x, y]` in the sketch's axes (y down).
+    Fixed([f64; 2]),
 }
 
 impl FillStyle {
@@ -131,6 +143,10 @@ impl FillStyle {
             tile,
             params,
             scale: toml.scale.unwrap_or(1.0),
+            flow: match toml.flow {
+                Some(DirectionToml::Vector(v)) => Flow::Fixed(v),
+                _ => Flow::Outline,
+            },
         })
     }
 
@@ -273,6 +289,9 @@ pub fn fill_sketch(opts: &FillOptions, sk: &Sketch) -> Result<FillOutput> {
         max_ppu = max_ppu.max(ppu);
         let margin = st.params.radius + 2;
         let mut region = Region::rasterize(&sk.path, &q.id, outline, rule, ppu, margin)?;
+        if let Flow::Fixed(d) = st.flow {
+            region.direction = constant_field(region.width(), region.height(), d);
+        }
         let combing: Vec<(&[Point], f64)> = strokes
             .iter()
             .filter(|(pts, _)| mostly_inside(outline, rule, pts))
@@ -290,6 +309,14 @@ pub fn fill_sketch(opts: &FillOptions, sk: &Sketch) -> Result<FillOutput> {
         ));
         let params = EmParams {
             seed: crate::pattern::rng::hash(&[opts.seed, qi as u64]),
+            // The Shape Hint takes the tile's edge to be a line along its
+            // direction, so it frames an outline only where the field runs
+            // along it: under a fixed flow it would pull bands across the
+            // outline and tear the pattern there.
+            shape: match st.flow {
+                Flow::Outline => st.params.shape,
+                Flow::Fixed(_) => 0.0,
+            },
             ..st.params
         };
         let syn = em::synthesize_in(&st.tile, &region.direction, Some(&region.mask), &params);

@@ -105,6 +105,12 @@ pub struct StyleToml {
     /// Fill: the tile's own direction, `"etf"` (estimated from the tile,
     /// Brushables §3.1) or a constant `[x, y]` in the tile's axes (y down).
     pub direction: Option<DirectionToml>,
+    /// Fill: what the tile's `direction` follows in a shape that no stroke
+    /// combs: `"outline"` (the outline's flow, Brushables §3.1; the
+    /// default) or a constant `[x, y]` in the sketch's axes (y down), for
+    /// patterns with one "up" such as scales, which cannot follow the vortex
+    /// that the flow of a closed outline turns around.
+    pub flow: Option<DirectionToml>,
     /// Fill: finest patch side in tile pixels (odd, 3..=33; default 9).
     pub patch: Option<u32>,
     /// Fill: pyramid levels (1..=5; default 3).
@@ -276,6 +282,20 @@ impl StyleToml {
             }
             _ => {}
         }
+        match &self.flow {
+            Some(DirectionToml::Vector(v))
+                if !(v[0].is_finite() && v[1].is_finite() && v[0].hypot(v[1]) > 1e-9) =>
+            {
+                return bad("flow", format!("must be a non-zero vector, got {v:?}"));
+            }
+            Some(DirectionToml::Named(n)) if n != "outline" => {
+                return bad(
+                    "flow",
+                    format!("must be \"outline\" or [x, y], got \"{n}\""),
+                );
+            }
+            _ => {}
+        }
         if let Some(p) = self.patch {
             if !(3..=33).contains(&p) || p % 2 == 0 {
                 return bad("patch", format!("must be odd and within 3..33 px, got {p}"));
@@ -376,6 +396,8 @@ mod tests {
         for (extra, key) in [
             ("direction = [0.0, 0.0]", "direction"),
             ("direction = \"north\"", "direction"),
+            ("flow = [0.0, 0.0]", "flow"),
+            ("flow = \"vortex\"", "flow"),
             ("patch = 8", "patch"),
             ("levels = 9", "levels"),
             ("iterations = 0", "iterations"),
