@@ -22,10 +22,10 @@ struct Cli {
     #[command(subcommand)]
     command: Command,
     /// Print nothing but errors.
-    #[arg(long, global = true)]
+    #[arg(short, long, global = true, conflicts_with = "verbose")]
     quiet: bool,
     /// Print notes about what was read and skipped.
-    #[arg(long, global = true)]
+    #[arg(short, long, global = true)]
     verbose: bool,
     /// Worker threads (default: one per core); output does not depend on it.
     #[arg(long, global = true, value_name = "N")]

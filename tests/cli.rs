@@ -1071,10 +1071,18 @@ fn diff_identical_files_exit_zero() {
     // A file against itself.
     let o = flourish(&["diff", s(&a), s(&a)]);
     assert_eq!(code(&o), Some(0));
-    // --quiet prints nothing.
-    let o = flourish(&["--quiet", "diff", s(&a), s(&b)]);
-    assert_eq!(code(&o), Some(0));
-    assert!(o.stdout.is_empty(), "stdout: {}", stdout(&o));
+    // --quiet (-q, before or after the subcommand) prints nothing.
+    for args in [
+        ["--quiet", "diff", s(&a), s(&b)],
+        ["diff", "-q", s(&a), s(&b)],
+    ] {
+        let o = flourish(&args);
+        assert_eq!(code(&o), Some(0));
+        assert!(o.stdout.is_empty(), "stdout: {}", stdout(&o));
+    }
+    // Quiet and verbose at once is a usage error.
+    let o = flourish(&["-q", "-v", "diff", s(&a), s(&b)]);
+    assert_eq!(code(&o), Some(2), "stderr: {}", stderr(&o));
 }
 
 #[test]
