@@ -1,5 +1,6 @@
 //! Draws the README's fill pictures: tile (3×3 repeats) | region | result,
-//! one PNG per shipped style, into `docs/fill-STYLE.png`.
+//! one PNG per shipped style, into `docs/fill-STYLE.png`; and a gallery of
+//! every style in every uncombed sample shape, `docs/fill-gallery.png`.
 //!
 //! Run: `cargo run --release --example fill_readme`.
 
@@ -51,11 +52,42 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             inner(&sketch),
             inner(&result)
         );
-        let out = root.join(format!("docs/fill-{style}.png"));
-        let tree = flourish::io::parse_svg(&out, svg.as_bytes())?;
-        let pixmap = render_tree(&out, &tree, Some(640), None)?;
-        std::fs::write(&out, pixmap.encode_png()?)?;
-        println!("{}", out.display());
+        write_png(&root.join(format!("docs/fill-{style}.png")), &svg, 640)?;
     }
+    // The gallery: a row per style, a column per shape.
+    let shapes = ["circle", "star", "letter", "frame"];
+    let styles = ["knot", "scales"];
+    let (w, h) = (200 * shapes.len(), 200 * styles.len());
+    let mut cells = String::new();
+    for (j, style) in styles.iter().enumerate() {
+        for (i, shape) in shapes.iter().enumerate() {
+            let opts = FillOptions {
+                style: (*style).into(),
+                ..FillOptions::default()
+            };
+            let sketch_path = root.join(format!("samples/fill/{shape}.svg"));
+            let result = run(&opts, &sketch_path)?.to_svg();
+            cells += &format!(
+                "<svg x=\"{}\" y=\"{}\" width=\"200\" height=\"200\" viewBox=\"0 0 200 200\">{}</svg>",
+                i * 200,
+                j * 200,
+                inner(&result)
+            );
+        }
+    }
+    let svg = format!(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" viewBox=\"0 0 {w} {h}\">\
+         <rect width=\"{w}\" height=\"{h}\" fill=\"#fff\"/>{cells}</svg>"
+    );
+    write_png(&root.join("docs/fill-gallery.png"), &svg, w as u32)?;
+    Ok(())
+}
+
+/// Renders SVG text `svg` at `width` px wide into the PNG file `out`.
+fn write_png(out: &Path, svg: &str, width: u32) -> Result<(), Box<dyn std::error::Error>> {
+    let tree = flourish::io::parse_svg(out, svg.as_bytes())?;
+    let pixmap = render_tree(out, &tree, Some(width), None)?;
+    std::fs::write(out, pixmap.encode_png()?)?;
+    println!("{}", out.display());
     Ok(())
 }
