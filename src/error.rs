@@ -38,7 +38,7 @@ pub enum Error {
         reason: String,
     },
     /// An input or requested canvas exceeds the resource limits.
-    #[error("{}: {width}×{height} px exceeds the size limit ({limit})", path.display())]
+    #[error("{}: {} exceeds the size limit ({limit})", path.display(), canvas_size(*width, *height))]
     TooLarge {
         /// The file concerned.
         path: PathBuf,
@@ -99,5 +99,47 @@ impl Error {
             path: path.into(),
             reason: reason.into(),
         }
+    }
+}
+
+/// A canvas size for messages: `W×H px` up to a billion px per side, else
+/// its order of magnitude (a saturated 2⁶⁴ − 1 from absurd coordinates
+/// reads "over 10¹⁹ px per side").
+fn canvas_size(width: u64, height: u64) -> String {
+    let side = width.max(height);
+    if side < 1_000_000_000 {
+        return format!("{width}×{height} px");
+    }
+    const SUP: [char; 10] = ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹'];
+    let digits: String = side
+        .ilog10()
+        .to_string()
+        .chars()
+        .filter_map(|c| c.to_digit(10))
+        .map(|d| SUP[d as usize])
+        .collect();
+    format!("a canvas of over 10{digits} px per side")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn size_errors_read_well_for_sane_and_absurd_sizes() {
+        let e = |width, height| {
+            Error::TooLarge {
+                path: "s.svg".into(),
+                width,
+                height,
+                limit: "L".into(),
+            }
+            .to_string()
+        };
+        assert_eq!(e(50_000, 20), "s.svg: 50000×20 px exceeds the size limit (L)");
+        assert_eq!(
+            e(u64::MAX, 3),
+            "s.svg: a canvas of over 10¹⁹ px per side exceeds the size limit (L)"
+        );
     }
 }

@@ -385,6 +385,33 @@ fn huge_declared_svg_canvas_is_capped_by_resolution() {
     assert!(!out.exists());
 }
 
+/// Shapes with coordinates of 10¹² or more (far off the canvas, or
+/// crossing it with an edge of nearly zero curvature) trace in moments:
+/// only the parts near the canvas are flattened and measured. (Flattening
+/// a circle of radius 10¹² px to 0.01 px once took minutes and gigabytes.)
+#[test]
+fn svg_shapes_with_huge_coordinates_trace_quickly() {
+    let t = tempdir();
+    let p = t.path().join("huge.svg");
+    std::fs::write(
+        &p,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="100" height="100">
+<circle cx="1e20" cy="5" r="1e19"/>
+<circle cx="50" cy="1e12" r="999999999950"/>
+<path d="M10 10 L 1e30 1e30 L 10 20Z"/>
+<rect x="20" y="20" width="10" height="10"/></svg>"#,
+    )
+    .unwrap();
+    let out = t.path().join("out.svg");
+    let (o, _) = flourish_timed(
+        t.path(),
+        &["trace", s(&p), "-o", s(&out)],
+        Duration::from_secs(120),
+    );
+    assert!(o.status.success(), "stderr: {}", stderr(&o));
+    assert!(std::fs::read_to_string(&out).unwrap().contains("<path"));
+}
+
 #[test]
 fn missing_input_fails_cleanly() {
     let t = tempdir();

@@ -108,13 +108,56 @@ impl Sdf {
     }
 }
 
+/// The part of `l` inside `r` (Liang–Barsky: the parameter interval where
+/// all four half-plane conditions hold), or `None` when it misses `r`.
+/// A clipped end is put on the boundary it was clipped at, exactly, so a
+/// segment with coordinates of 10³⁰ still clips to the right place.
+fn clip_line(l: Line, r: kurbo::Rect) -> Option<Line> {
+    if !(l.p0.is_finite() && l.p1.is_finite()) {
+        return None;
+    }
+    let d = l.p1 - l.p0;
+    // Each end: its parameter and, when clipped, the boundary (axis, value).
+    let (mut t0, mut t1) = ((0.0f64, None), (1.0f64, None));
+    for (p, q, axis, bound) in [
+        (-d.x, l.p0.x - r.x0, 0, r.x0),
+        (d.x, r.x1 - l.p0.x, 0, r.x1),
+        (-d.y, l.p0.y - r.y0, 1, r.y0),
+        (d.y, r.y1 - l.p0.y, 1, r.y1),
+    ] {
+        if p == 0.0 {
+            if q < 0.0 {
+                return None;
+            }
+        } else {
+            let t = q / p;
+            if p < 0.0 && t > t0.0 {
+                t0 = (t, Some((axis, bound)));
+            } else if p > 0.0 && t < t1.0 {
+                t1 = (t, Some((axis, bound)));
+            }
+        }
+    }
+    let at = |edge: Option<(usize, f64)>, end: Point| match edge {
+        None => end,
+        Some((0, x)) => Point::new(x, l.p0.y + (x - l.p0.x) * (d.y / d.x)),
+        Some((_, y)) => Point::new(l.p0.x + (y - l.p0.y) * (d.x / d.y), y),
+    };
+    (t0.0 <= t1.0).then(|| Line::new(at(t0.1, l.p0), at(t1.1, l.p1)))
+}
+
 /// Signed distances to `segments`: exact within [`BAND`], from the EDT
 /// beyond; sign from `inside`.
 fn distance_to_segments(inside: &Grid<bool>, segments: &[Line]) -> Grid<f32> {
     let (w, h) = (inside.width(), inside.height());
     // Split long segments so each touches a small window of pixels.
+    // Only the part of a segment within BAND of the grid can be the nearest
+    // one within BAND of a pixel: the rest is clipped away first, so a
+    // segment kilometres long costs what its visible part costs.
+    let reach = BAND as f64 + 1.0;
+    let window = kurbo::Rect::new(-reach, -reach, w as f64 + reach, h as f64 + reach);
     let mut pieces: Vec<Line> = Vec::with_capacity(segments.len());
-    for s in segments {
+    for s in segments.iter().filter_map(|s| clip_line(*s, window)) {
         let len = s.length();
         if !len.is_finite() {
             continue;
@@ -357,6 +400,56 @@ pub fn subpixel_outline(cov: &Coverage) -> Vec<Vec<Point>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn clip_line_keeps_exactly_the_part_inside() {
+        // Against sampling: a point of the segment is inside the rectangle
+        // exactly when it lies on the clipped piece.
+        let r = kurbo::Rect::new(-2.0, -1.0, 10.0, 7.0);
+        let mut state = 12345u64;
+        let mut rnd = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 11) as f64 / (1u64 << 53) as f64) * 30.0 - 10.0
+        };
+        for _ in 0..500 {
+            let l = Line::new((rnd(), rnd()), (rnd(), rnd()));
+            let c = clip_line(l, r);
+            for k in 0..=200 {
+                let p = l.p0.lerp(l.p1, k as f64 / 200.0);
+                let inside = r.x0 <= p.x && p.x <= r.x1 && r.y0 <= p.y && p.y <= r.y1;
+                let on = c.is_some_and(|c| point_segment_distance(p, c) < 1e-9);
+                assert_eq!(inside, on, "{l:?} clipped to {c:?} at {p:?}");
+            }
+        }
+        // Kilometres long and NaN.
+        let far = Line::new((-1e30, 3.0), (1e30, 3.0));
+        let c = clip_line(far, r).unwrap();
+        assert!(
+            (c.p0.x + 2.0).abs() < 1e-6 && (c.p1.x - 10.0).abs() < 1e-6,
+            "{c:?}"
+        );
+        assert!(clip_line(Line::new((f64::NAN, 0.0), (1.0, 1.0)), r).is_none());
+    }
+
+    #[test]
+    fn a_segment_far_longer_than_the_grid_costs_only_its_visible_part() {
+        // One edge of a triangle 10¹² px tall; the exact distances near the
+        // visible edge are those of the unclipped line.
+        let inside = Grid::from_fn(16, 16, |x, _| x < 8);
+        let segs = [Line::new((8.0, -1e12), (8.0, 1e12))];
+        let sdf = Sdf::from_segments(&inside, &segs, Affine::IDENTITY);
+        for y in 0..16 {
+            for x in 0..16 {
+                let want = (x as f32 + 0.5 - 8.0).min(BAND + 1.0);
+                let got = sdf.dist.get(x, y);
+                if want.abs() <= BAND {
+                    assert!((got - want).abs() < 1e-4, "({x}, {y}): {got} vs {want}");
+                }
+            }
+        }
+    }
 
     /// Exact area coverage of a shape by 16×16 supersampling.
     fn coverage(w: usize, h: usize, inside: impl Fn(f64, f64) -> bool + Sync) -> Coverage {
