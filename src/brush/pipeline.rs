@@ -158,8 +158,39 @@ pub struct Resampled {
     pub left: Vec<Point>,
     /// Right outline points.
     pub right: Vec<Point>,
-    /// Ink fraction across each rib (appearance descriptor).
+    /// Ink fraction across each rib.
     pub ink: Vec<f64>,
+    /// Ink cross-section of each rib (the appearance descriptor of the
+    /// matching's jumps, [`cross_section`]).
+    pub profile: Vec<Vec<f64>>,
+}
+
+/// Points at which a rib's ink cross-section is read, evenly from its left
+/// to its right end.
+pub const PROFILE_SAMPLES: usize = 9;
+
+/// Finest px over which the cross-section's ink ramps from 1 (inside) to 0
+/// (outside): a line read a pixel or two off its place still matches.
+pub const PROFILE_RAMP: f64 = 3.0;
+
+/// The ink cross-section of the rib from `left` to `right` (finest px) in
+/// the all-ink SDF `sdf` (finest px, pixel centres at half-integers): [`PROFILE_SAMPLES`] soft ink values
+/// `clamp(½ − d / PROFILE_RAMP, 0, 1)` at the centres of equal steps
+/// across the rib, scaled by `1 / √PROFILE_SAMPLES` so the squared distance
+/// of two profiles is their mean squared difference. Where the ornament
+/// lines cross a rib (the lines of a loop, a leaf's edges, a spike's base)
+/// is what a seam must join up: the matching's jumps compare these
+/// profiles (decobrush.txt §5.1, "jumps between library segments that have
+/// very different appearance").
+pub fn cross_section(sdf: &Grid<f32>, left: Point, right: Point) -> Vec<f64> {
+    let n = PROFILE_SAMPLES as f64;
+    (0..PROFILE_SAMPLES)
+        .map(|i| {
+            let p = left.lerp(right, (i as f64 + 0.5) / n);
+            let d = sdf.sample(p.x, p.y) as f64;
+            (0.5 - d / PROFILE_RAMP).clamp(0.0, 1.0) / n.sqrt()
+        })
+        .collect()
 }
 
 /// Resamples exemplar `e`'s ribs at arc-length spacing `h` (finest px),
@@ -183,7 +214,9 @@ pub fn resample_ribs(style: &BrushStyle, e: usize, h: f64) -> Option<Resampled> 
         left: Vec::with_capacity(m),
         right: Vec::with_capacity(m),
         ink: Vec::with_capacity(m),
+        profile: Vec::with_capacity(m),
     };
+    let sdf = &ex.finest()?.ink.ink;
     for k in 0..m {
         let s = len * k as f64 / (m - 1) as f64;
         let i = arc.partition_point(|&a| a <= s).clamp(1, n - 1);
@@ -198,8 +231,26 @@ pub fn resample_ribs(style: &BrushStyle, e: usize, h: f64) -> Option<Resampled> 
         out.right.push(p(r.right[i - 1]).lerp(p(r.right[i]), t));
         let ink = ex.features[i - 1].ink as f64 * (1.0 - t) + ex.features[i].ink as f64 * t;
         out.ink.push(ink);
+        if let (Some(&l), Some(&r)) = (out.left.last(), out.right.last()) {
+            out.profile.push(cross_section(sdf, l, r));
+        }
     }
     Some(out)
+}
+
+/// The stroke width of an exemplar at rib `i`, finest px: the longest rib
+/// within `half` ribs either way (half a stroke width). A rib reaches the
+/// farthest ink across the spine, so along a chain of loops or leaves it
+/// is long at each loop and short between them; the width a designer drew
+/// such an ornament with, the one the query's stroke width is compared to
+/// (§5.1), is the envelope over about one stroke width.
+fn stroke_width(ribs: &[f64], i: usize, half: usize) -> f64 {
+    let lo = i.saturating_sub(half);
+    let hi = (i + half + 1).min(ribs.len());
+    ribs.get(lo..hi)
+        .unwrap_or(&[])
+        .iter()
+        .fold(0.0, |a: f64, &b| a.max(b))
 }
 
 /// The matching features of resampled exemplar ribs, in sketch units
@@ -211,19 +262,33 @@ fn exemplar_features(r: &Resampled, scale: f64, mean_width: f64) -> SpineFeature
         .map(|q| (q.to_vec2() * scale).to_point())
         .collect();
     let len = query::polyline_length(&pts);
+    let ribs: Vec<f64> = r
+        .left
+        .iter()
+        .zip(&r.right)
+        .map(|(l, q)| l.distance(*q))
+        .collect();
+    // Samples within half a stroke width either way (the spacing is the
+    // same all along the resampled spine).
+    let spacing = len / (pts.len().max(2) - 1) as f64;
+    let half = if spacing > 0.0 {
+        (0.5 * mean_width * scale / spacing).round() as usize
+    } else {
+        0
+    };
     let samples = query::features(&pts, mean_width * scale, len)
         .into_iter()
         .enumerate()
         .map(|(i, s)| SampleFeature {
             turning: s.turning,
-            width: r.left[i].distance(r.right[i]) * scale,
+            width: stroke_width(&ribs, i, half) * scale,
             dist_start: s.dist_start,
             dist_end: s.dist_end,
         })
         .collect();
     SpineFeatures {
         samples,
-        appearance: r.ink.iter().map(|&v| vec![v]).collect(),
+        appearance: r.profile.clone(),
     }
 }
 
