@@ -12,9 +12,12 @@
 //!   matched to an exemplar sample that is not near the same end (the curls
 //!   at the ends must not be cut short), and a **middle penalty** when a
 //!   middle query sample takes an exemplar end;
-//! - a **jump penalty** at every segment boundary, plus the squared
-//!   difference of the two boundary samples' appearance descriptors and
-//!   thicknesses (rib lengths), so jumps happen only between look-alikes;
+//! - a **jump penalty** at every segment boundary, plus the mean squared
+//!   difference of the appearance descriptors the two segments lay on the
+//!   same query samples over the overlap (the next segment's samples
+//!   against the continuation of the one it leaves) and the squared
+//!   difference of the boundary thicknesses (rib lengths), so jumps
+//!   happen only where the two look alike all across the seam region;
 //! - a minimum and an optional maximum segment length (in samples).
 //!
 //! The minimum is found by dynamic programming over (query sample,
@@ -338,7 +341,9 @@ impl<'a> Problem<'a> {
     }
 
     /// The cost of a boundary from exemplar sample `from` (the last of a
-    /// segment) to `to` (the first of the next).
+    /// segment) to `to` (the first of the next): the jump penalty, the
+    /// appearance difference over the overlap and the thickness
+    /// difference (see the module docs); infinite for samples out of range.
     pub fn jump(&self, from: (usize, usize), to: (usize, usize)) -> f64 {
         let o = self.opts;
         let get = |(e, s): (usize, usize)| {
@@ -349,9 +354,39 @@ impl<'a> Problem<'a> {
             return f64::INFINITY;
         };
         let dw = (fa.width - fb.width) / self.mean_width;
-        let app: f64 = match (aa, ab) {
-            (Some(x), Some(y)) => x.iter().zip(y).map(|(u, v)| (u - v) * (u - v)).sum(),
-            _ => 0.0,
+        let d2 = |x: &Vec<f64>, y: &Vec<f64>| -> f64 {
+            x.iter().zip(y).map(|(u, v)| (u - v) * (u - v)).sum()
+        };
+        // Over the overlap the two segments are laid on the same query
+        // samples: `to + k` of the next against `from + 1 + k` of the one
+        // it leaves (its continuation), for |k| ≤ overlap; the mean of
+        // their appearance differences, or the boundary pair's alone where
+        // neither exemplar reaches further.
+        let (Some(xa), Some(xb)) = (self.exemplars.get(from.0), self.exemplars.get(to.0)) else {
+            return f64::INFINITY;
+        };
+        let w = o.overlap as isize;
+        let (mut sum, mut n) = (0.0, 0usize);
+        for k in -w..=w {
+            let (sa, sb) = (from.1 as isize + 1 + k, to.1 as isize + k);
+            if sa < 0 || sb < 0 {
+                continue;
+            }
+            if let (Some(x), Some(y)) = (
+                xa.appearance.get(sa as usize),
+                xb.appearance.get(sb as usize),
+            ) {
+                sum += d2(x, y);
+                n += 1;
+            }
+        }
+        let app = if n > 0 {
+            sum / n as f64
+        } else {
+            match (aa, ab) {
+                (Some(x), Some(y)) => d2(x, y),
+                _ => 0.0,
+            }
         };
         o.jump_penalty + o.w_appearance * app + o.w_thickness * dw * dw
     }
