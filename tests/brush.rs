@@ -199,12 +199,10 @@ fn correction_leaves_an_exact_exemplar_copy_unchanged() {
     }
 }
 
-/// Structure statistics of an ink mask whose stroke width is `width_px`:
-/// (components + line ends) per stroke width of path length, and the
-/// line thicknesses (twice the distance to paper at ridge pixels, px).
-fn structure(mask: &Grid<bool>, width_px: f64, length_px: f64) -> (f64, Vec<f64>) {
+/// Distance to paper of every ink pixel, px, by a two-pass chamfer
+/// transform (3-4 weights / 3; paper and the grid's outside are 0).
+fn paper_distance(mask: &Grid<bool>) -> Grid<f64> {
     let (w, h) = (mask.width(), mask.height());
-    // Distance to paper by a two-pass chamfer transform (3-4 weights / 3).
     let big = 1e9f64;
     let mut d = Grid::from_fn(w, h, |x, y| if mask.get(x, y) { big } else { 0.0 });
     let fwd = [
@@ -233,33 +231,70 @@ fn structure(mask: &Grid<bool>, width_px: f64, length_px: f64) -> (f64, Vec<f64>
             }
         }
     }
-    // Ridges: ink pixels whose distance is a maximum along x or y.
-    let ridge = Grid::from_fn(w, h, |x, y| {
-        let v = d.get(x, y);
-        let g = |dx: isize, dy: isize| d.get_or(x as isize + dx, y as isize + dy, 0.0);
-        v > 0.0 && ((v >= g(-1, 0) && v >= g(1, 0)) || (v >= g(0, -1) && v >= g(0, 1)))
-    });
+    d
+}
+
+/// The line thicknesses of an ink mask: twice the distance to paper at
+/// ridge pixels (ink pixels whose distance is a maximum along x or y), px.
+fn thicknesses(mask: &Grid<bool>) -> Vec<f64> {
+    let d = paper_distance(mask);
     let mut thick = Vec::new();
-    let mut ends = 0usize;
-    for y in 0..h {
-        for x in 0..w {
-            if !ridge.get(x, y) {
-                continue;
-            }
-            thick.push(2.0 * d.get(x, y));
-            let n = (-1isize..=1)
-                .flat_map(|dy| (-1isize..=1).map(move |dx| (dx, dy)))
-                .filter(|&(dx, dy)| {
-                    (dx, dy) != (0, 0) && ridge.get_or(x as isize + dx, y as isize + dy, false)
-                })
-                .count();
-            if n == 1 {
-                ends += 1;
+    for y in 0..mask.height() {
+        for x in 0..mask.width() {
+            let v = d.get(x, y);
+            let g = |dx: isize, dy: isize| d.get_or(x as isize + dx, y as isize + dy, 0.0);
+            if v > 0.0 && ((v >= g(-1, 0) && v >= g(1, 0)) || (v >= g(0, -1) && v >= g(0, 1))) {
+                thick.push(2.0 * v);
             }
         }
     }
-    let comps = components(mask).len();
-    (((comps + ends) as f64) / (length_px / width_px), thick)
+    thick
+}
+
+/// What a designer counts along an ornament, by eye.
+#[derive(Clone, Copy, Debug)]
+struct Structure {
+    /// Ink pieces (4-connected components).
+    pieces: usize,
+    /// Line ends: end points of the skeleton pruned by `min_branch`
+    /// ([`flourish::fill::continuity::band_ends`]), so spurs thinning grows
+    /// from pixel steps and bumps of an outline are not ends.
+    ends: usize,
+    /// Loops: holes (paper components not touching the canvas border) of at
+    /// least a median line thickness squared.
+    loops: usize,
+}
+
+impl Structure {
+    /// Counted features per stroke width of path length.
+    fn density(&self, width_px: f64, length_px: f64) -> f64 {
+        (self.pieces + self.ends + self.loops) as f64 / (length_px / width_px)
+    }
+}
+
+/// The structure of an ink mask (see [`Structure`]): `min_branch` is the
+/// spur length pruned from the skeleton and `min_hole` the smallest hole
+/// counted as a loop, px and px².
+fn structure(mask: &Grid<bool>, min_branch: usize, min_hole: usize) -> Structure {
+    let (w, h) = (mask.width(), mask.height());
+    let everywhere = Grid::new(w, h, true);
+    let ends = flourish::fill::continuity::band_ends(mask, &everywhere, min_branch);
+    let paper = mask.map(|v| !v);
+    let loops = components(&paper)
+        .iter()
+        .filter(|c| {
+            c.len() >= min_hole
+                && c.iter().all(|&i| {
+                    let (x, y) = (i % w, i / w);
+                    x > 0 && y > 0 && x + 1 < w && y + 1 < h
+                })
+        })
+        .count();
+    Structure {
+        pieces: components(mask).len(),
+        ends,
+        loops,
+    }
 }
 
 /// Earth mover's distance between two 1-D samples (quantile matching).
@@ -279,6 +314,24 @@ fn emd(a: &[f64], b: &[f64]) -> f64 {
         / n as f64
 }
 
+/// The spur length pruned from skeletons, px: one median line thickness
+/// of the exemplars. A spur that thinning grows from a pixel step or a
+/// bump of an outline runs from the medial axis to the outline, at most
+/// half its line's thickness and a pixel long, so this removes them on
+/// lines up to twice the median thickness; a spike, leaf tip, curl end or
+/// hook that a designer counts sticks out a line thickness or more beyond
+/// the line it grows from.
+fn min_branch(median_thickness: f64) -> usize {
+    median_thickness.round().max(1.0) as usize
+}
+
+/// The median of a sample (0 when empty).
+fn median(v: &[f64]) -> f64 {
+    let mut v = v.to_vec();
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(0.0)
+}
+
 #[test]
 fn flourish_keeps_the_exemplars_structure_where_the_art_brush_drifts() {
     for st in ["vine", "doodle", "scroll"] {
@@ -286,16 +339,32 @@ fn flourish_keeps_the_exemplars_structure_where_the_art_brush_drifts() {
         // The exemplars' own figures, at the finest level, per stroke
         // width: the style's exemplar width, the same finest-px width the
         // canvas maps each query's stroke width to, so exemplars and
-        // outputs are counted per the same length of ornament.
+        // outputs are counted per the same length of ornament and with the
+        // same pruning length and smallest loop.
         let ew = flourish::brush::pipeline::exemplar_width(style).unwrap();
+        let masks: Vec<(Grid<bool>, f64)> = style
+            .exemplars
+            .iter()
+            .map(|e| {
+                (
+                    e.finest().unwrap().ink.ink.map(|v| v < 0.0),
+                    e.spine_length(),
+                )
+            })
+            .collect();
+        let ex_thick: Vec<f64> = masks.iter().flat_map(|(m, _)| thicknesses(m)).collect();
+        let t = median(&ex_thick);
+        let (spur, hole) = (min_branch(t), (t * t).round() as usize);
         let mut ex_density = 0.0;
-        let mut ex_thick = Vec::new();
-        for e in &style.exemplars {
-            let lv = e.finest().unwrap();
-            let mask = lv.ink.ink.map(|v| v < 0.0);
-            let (dens, th) = structure(&mask, ew, e.spine_length());
-            ex_density += dens / style.exemplars.len() as f64;
-            ex_thick.extend(th);
+        let mut ex_counts = (0, 0, 0);
+        for (mask, len) in &masks {
+            let s = structure(mask, spur, hole);
+            ex_counts = (
+                ex_counts.0 + s.pieces,
+                ex_counts.1 + s.ends,
+                ex_counts.2 + s.loops,
+            );
+            ex_density += s.density(ew, *len) / masks.len() as f64;
         }
         // A long meander, about 60 stroke widths: far longer than any
         // exemplar, which the art brush must stretch.
@@ -313,10 +382,18 @@ fn flourish_keeps_the_exemplars_structure_where_the_art_brush_drifts() {
             let r = &out.queries[0];
             let mask = ink(style, r);
             let ppu = r.canvas.px_per_unit;
-            let (dens, th) = structure(&mask, r.spine.width * ppu, r.spine.length * ppu);
-            figures.push((dens, emd(&th, &ex_thick)));
+            let s = structure(&mask, spur, hole);
+            let dens = s.density(r.spine.width * ppu, r.spine.length * ppu);
+            figures.push((dens, emd(&thicknesses(&mask), &ex_thick), s));
         }
         let (fl, ab) = (figures[0], figures[1]);
+        eprintln!(
+            "{st}: median exemplar line {t:.1} px (spurs under {spur} px pruned, loops from {hole} px²); \
+             pieces/ends/loops: exemplars {ex_counts:?} over {} exemplars, flourish {:?}, art brush {:?}",
+            masks.len(),
+            (fl.2.pieces, fl.2.ends, fl.2.loops),
+            (ab.2.pieces, ab.2.ends, ab.2.loops)
+        );
         eprintln!(
             "{st}: structure density per width: exemplars {ex_density:.3}, flourish {:.3}, art brush {:.3}; \
              thickness EMD to the exemplars (px): flourish {:.3}, art brush {:.3}",
@@ -328,32 +405,22 @@ fn flourish_keeps_the_exemplars_structure_where_the_art_brush_drifts() {
             rel(fl.0),
             rel(ab.0)
         );
-        // Flourish keeps the exemplars' structure density (pieces and line
-        // ends per width: spurs, breaks and debris raise it, a stretched
-        // copy lowers it) within 30 %, and closer than the stretched
-        // baseline; its line thicknesses stay the exemplars' where the
-        // baseline's drift.
-        // Flourish keeps the exemplars' structure density (pieces and line
-        // ends per width: spurs, breaks and debris raise it, a stretched
-        // copy lowers it) within 30 %, and closer than the stretched
-        // baseline. The doodle misses this (README, "Brush limits"): its
-        // long queries pack loops tighter than the exemplars and seams
-        // leave small hooks, about +64 %; it is held to +70 % so a
-        // regression still fails.
-        let bound = if st == "doodle" { 0.7 } else { 0.3 };
+        // Flourish keeps the exemplars' structure density (pieces, line
+        // ends and loops per width: spurs, breaks, debris and packed loops
+        // raise it, a stretched copy lowers it) within 30 %, and closer
+        // than the stretched baseline; its line thicknesses stay the
+        // exemplars' where the baseline's drift.
         assert!(
-            rel(fl.0) <= bound,
+            rel(fl.0) <= 0.3,
             "{st}: flourish density {} vs exemplars {ex_density}",
             fl.0
         );
-        if st != "doodle" {
-            assert!(
-                rel(fl.0) < rel(ab.0),
-                "{st}: flourish density drift {} vs art brush {}",
-                rel(fl.0),
-                rel(ab.0)
-            );
-        }
+        assert!(
+            rel(fl.0) < rel(ab.0),
+            "{st}: flourish density drift {} vs art brush {}",
+            rel(fl.0),
+            rel(ab.0)
+        );
         assert!(
             fl.1 < 0.5 * ab.1,
             "{st}: thickness EMD flourish {} vs art brush {}",

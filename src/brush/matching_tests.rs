@@ -74,6 +74,36 @@ fn features(max_len: usize) -> impl Strategy<Value = SpineFeatures> {
     })
 }
 
+/// The bounds of the overlap extension (see `segments_of`): at most the
+/// option, at most half the neighbour's core, and only over query samples
+/// whose zone is that of the exemplar sample they take.
+fn extensions_are_bounded(p: &Problem, m: &Matching) -> Result<(), TestCaseError> {
+    let segs = &m.segments;
+    for (k, s) in segs.iter().enumerate() {
+        let before = s.core.start - s.query.start;
+        let after = s.query.end - s.core.end;
+        prop_assert!(before <= p.opts.overlap && after <= p.opts.overlap);
+        let prev = k.checked_sub(1).map_or(0, |j| segs[j].core.len() / 2);
+        let next = segs.get(k + 1).map_or(0, |n| n.core.len() / 2);
+        prop_assert!(
+            before <= prev,
+            "{before} samples into a core of {}",
+            2 * prev
+        );
+        prop_assert!(after <= next, "{after} samples into a core of {}", 2 * next);
+        for (i, q) in s.query.clone().enumerate() {
+            if s.core.contains(&q) {
+                continue;
+            }
+            let e = s.exemplar_samples.start + i;
+            let zq = p.zone_of(&p.query.samples[q]);
+            let ze = p.zone_of(&p.exemplars[s.exemplar].samples[e]);
+            prop_assert_eq!(zq, ze, "sample {} extended over exemplar sample {}", q, e);
+        }
+    }
+    Ok(())
+}
+
 fn core_cost(p: &Problem, m: &Matching) -> f64 {
     let segs: Vec<_> = m
         .segments
@@ -124,6 +154,7 @@ proptest! {
                     q = s.core.end;
                 }
                 prop_assert_eq!(q, query.samples.len());
+                extensions_are_bounded(&p, &m)?;
             }
             Err(_) => prop_assert!(brute.is_infinite()),
         }
@@ -137,7 +168,10 @@ proptest! {
         let exact = MatchOptions { candidates: usize::MAX, min_segment: 2, ..MatchOptions::default() };
         let pruned = MatchOptions { candidates: 3, beam: 2, ..exact.clone() };
         let p = Problem::new(&query, &exemplars, &pruned).unwrap();
-        if let (Ok(a), Ok(b)) = (match_query(&query, &exemplars, &exact), match_query(&query, &exemplars, &pruned)) {
+        let (a, b) = (match_query(&query, &exemplars, &exact), match_query(&query, &exemplars, &pruned));
+        // Feasible whenever the exact search is (the exact retry).
+        prop_assert_eq!(a.is_ok(), b.is_ok());
+        if let (Ok(a), Ok(b)) = (a, b) {
             prop_assert!(b.cost >= a.cost - 1e-9 * (1.0 + a.cost));
             prop_assert!((core_cost(&p, &b) - b.cost).abs() <= 1e-7 * (1.0 + b.cost));
         }
@@ -156,7 +190,14 @@ fn query_ends_take_exemplar_ends() {
     let last = &m.segments[m.segments.len() - 1];
     assert_eq!(first.exemplar_samples.start, 0);
     assert_eq!(last.exemplar_samples.end, 40);
-    assert!(m.cost < 10.0, "no end penalty paid: {}", m.cost);
+    let o = MatchOptions::default();
+    assert!(
+        m.cost <= o.jump_penalty + 1e-9,
+        "one jump and no end penalty paid: {}",
+        m.cost
+    );
+    let p = Problem::new(&q, &ex, &o).unwrap();
+    extensions_are_bounded(&p, &m).unwrap();
     // Neighbours overlap by the extension.
     for w in m.segments.windows(2) {
         assert!(w[0].query.end > w[1].query.start);

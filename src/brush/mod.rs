@@ -7,6 +7,8 @@
 //!   the ends);
 //! - [`matching`]: §5.1 piecewise matching, a dynamic programme over
 //!   exemplar segments (oracle: exhaustive search on tiny inputs);
+//! - [`ribs`]: the exemplars' ribs resampled at the query's pace with
+//!   their matching features (stroke-width envelope, ink cross-sections);
 //! - [`arap`]: §5.2 as-rigid-as-possible deformation of a segment's rib mesh
 //!   onto the query spine (Igarashi et al. 2005), and the rasterized map back
 //!   to exemplar coordinates;
@@ -29,4 +31,5 @@ pub mod maxflow;
 pub mod output;
 pub mod pipeline;
 pub mod query;
+pub mod ribs;
 pub mod synth;

@@ -17,8 +17,10 @@
 use super::arap::{rasterize_coords, Arap, RibMesh};
 use super::baseline::art_brush_coords;
 use super::graphcut::{seam, Cover, Label, SeamParams};
-use super::matching::{match_query, MatchOptions, SampleFeature, SpineFeatures};
-use super::query::{self, QueryOptions, QuerySpine};
+use super::matching::{match_query, MatchOptions, SpineFeatures};
+use super::query::{QueryOptions, QuerySpine};
+use super::ribs::{exemplar_features, resample_ribs};
+pub use super::ribs::{exemplar_width, WIDTH_PERCENTILE};
 use super::synth::{self, Coord, Field, SynthOptions};
 use crate::error::{Error, Result};
 use crate::raster::Grid;
@@ -120,111 +122,6 @@ pub fn start_level(style: &BrushStyle, ew: f64) -> usize {
         .iter()
         .position(|l| ew * l.scale >= MIN_SYNTH_WIDTH)
         .unwrap_or(e.levels.len().saturating_sub(1))
-}
-
-/// Percentile of the style's rib widths taken as "the exemplar width".
-pub const WIDTH_PERCENTILE: f64 = 0.8;
-
-/// The style's exemplar width, finest px: the [`WIDTH_PERCENTILE`] of all
-/// rib widths (ribs reach the farthest ink, leaves and curls included, so
-/// a high percentile keeps the ornament within the stroke the designer
-/// drew).
-pub fn exemplar_width(style: &BrushStyle) -> Result<f64> {
-    let mut ws: Vec<f64> = style
-        .exemplars
-        .iter()
-        .flat_map(|e| e.ribs.widths())
-        .filter(|w| w.is_finite() && *w > 0.0)
-        .collect();
-    ws.sort_by(f64::total_cmp);
-    let k = ((ws.len() as f64 - 1.0) * WIDTH_PERCENTILE)
-        .round()
-        .max(0.0) as usize;
-    match ws.get(k) {
-        Some(&w) => Ok(w),
-        None => Err(Error::degenerate(
-            format!("style {}", style.name),
-            "its exemplars have no rib widths",
-        )),
-    }
-}
-
-/// An exemplar's ribs resampled at a given spacing, finest px.
-#[derive(Clone, Debug)]
-pub struct Resampled {
-    /// Spine points.
-    pub spine: Vec<Point>,
-    /// Left outline points.
-    pub left: Vec<Point>,
-    /// Right outline points.
-    pub right: Vec<Point>,
-    /// Ink fraction across each rib (appearance descriptor).
-    pub ink: Vec<f64>,
-}
-
-/// Resamples exemplar `e`'s ribs at arc-length spacing `h` (finest px),
-/// linearly interpolating spine, outline points and rib ink.
-pub fn resample_ribs(style: &BrushStyle, e: usize, h: f64) -> Option<Resampled> {
-    let ex = style.exemplars.get(e)?;
-    let r = &ex.ribs;
-    let n = r.len();
-    if n < 2 || ex.features.len() != n || h.is_nan() || h <= 0.0 {
-        return None;
-    }
-    let p = |v: [f64; 2]| Point::new(v[0], v[1]);
-    let mut arc = vec![0.0; n];
-    for i in 1..n {
-        arc[i] = arc[i - 1] + p(r.spine[i]).distance(p(r.spine[i - 1]));
-    }
-    let len = arc[n - 1];
-    let m = ((len / h).round() as usize).clamp(1, 100_000) + 1;
-    let mut out = Resampled {
-        spine: Vec::with_capacity(m),
-        left: Vec::with_capacity(m),
-        right: Vec::with_capacity(m),
-        ink: Vec::with_capacity(m),
-    };
-    for k in 0..m {
-        let s = len * k as f64 / (m - 1) as f64;
-        let i = arc.partition_point(|&a| a <= s).clamp(1, n - 1);
-        let (a, b) = (arc[i - 1], arc[i]);
-        let t = if b > a {
-            ((s - a) / (b - a)).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        out.spine.push(p(r.spine[i - 1]).lerp(p(r.spine[i]), t));
-        out.left.push(p(r.left[i - 1]).lerp(p(r.left[i]), t));
-        out.right.push(p(r.right[i - 1]).lerp(p(r.right[i]), t));
-        let ink = ex.features[i - 1].ink as f64 * (1.0 - t) + ex.features[i].ink as f64 * t;
-        out.ink.push(ink);
-    }
-    Some(out)
-}
-
-/// The matching features of resampled exemplar ribs, in sketch units
-/// (`scale` sketch units per finest px).
-fn exemplar_features(r: &Resampled, scale: f64, mean_width: f64) -> SpineFeatures {
-    let pts: Vec<Point> = r
-        .spine
-        .iter()
-        .map(|q| (q.to_vec2() * scale).to_point())
-        .collect();
-    let len = query::polyline_length(&pts);
-    let samples = query::features(&pts, mean_width * scale, len)
-        .into_iter()
-        .enumerate()
-        .map(|(i, s)| SampleFeature {
-            turning: s.turning,
-            width: r.left[i].distance(r.right[i]) * scale,
-            dist_start: s.dist_start,
-            dist_end: s.dist_end,
-        })
-        .collect();
-    SpineFeatures {
-        samples,
-        appearance: r.ink.iter().map(|&v| vec![v]).collect(),
-    }
 }
 
 /// The canvas of a query spine: its bounding box grown by one stroke width,
