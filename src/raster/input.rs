@@ -134,6 +134,10 @@ pub struct OutlineInk {
     pub color: Color,
     /// The outline's closed loops, in pixel coordinates.
     pub loops: Vec<super::binary::SmoothLoop>,
+    /// For a binary bitmap, where its edge may lie: curves fitted to the
+    /// loops may use this band instead of hugging them. None for an
+    /// anti-aliased bitmap, whose outline is known to a fraction of a pixel.
+    pub corridor: Option<super::corridor::Corridor>,
 }
 
 /// Reads `path` for tracing: like [`load`], except that a binary bitmap
@@ -149,6 +153,7 @@ pub fn load_traceable(path: &Path, opts: &InputOptions) -> Result<Traceable> {
             height: h as f64,
             color,
             loops: super::binary::smooth_loops(&cov),
+            corridor: Some(super::corridor::Corridor::new(&cov)),
         })),
         // One anti-aliased layer: its sub-pixel outline, fitted directly.
         RasterCoverage::Layers { w, h, layers } if layers.len() == 1 && !opts.layers => {
@@ -162,6 +167,7 @@ pub fn load_traceable(path: &Path, opts: &InputOptions) -> Result<Traceable> {
                     .filter(|p| p.len() >= 3)
                     .map(super::binary::polygon_loop)
                     .collect(),
+                corridor: None,
             }))
         }
         other => Ok(Traceable::Field(other.into_ink())),

@@ -6,12 +6,14 @@
 //! tangents perpendicular to the SDF gradient, which is smooth where the
 //! outline is, so pieces join with G1 continuity. `fit_to_bezpath_opt`
 //! then finds the fewest cubics within the tolerance. An outline known
-//! exactly (a binary bitmap's smoothed outline) is fitted the same way by
-//! [`fit_outline`], with its own tangents and corners, and each curve is
-//! checked against the outline itself instead of an SDF. Corners are the
+//! exactly (a bitmap's smoothed or sub-pixel outline) is fitted with the
+//! same [`Piece`] source by [`super::cover`], with its own tangents and
+//! corners, exact moment integrals, and each curve checked against the
+//! outline itself (and a binary bitmap's corridor) instead of an SDF. Corners are the
 //! vertices where the outline turns sharply within a pixel-scale window;
 //! the curves meet there at an angle, so sharp corners stay sharp.
 
+use crate::raster::corridor::Corridor;
 use crate::raster::Sdf;
 use kurbo::{
     Affine, BezPath, CubicBez, CurveFitSample, ParamCurve, ParamCurveArclen, ParamCurveFit, Point,
@@ -38,19 +40,22 @@ const CORNER_REACH: f64 = 1.5;
 /// What a piece is fitted to: where its tangents come from and what the
 /// fitted curves are checked against.
 #[derive(Clone, Copy)]
-enum Guide<'a> {
+pub(super) enum Guide<'a> {
     /// A marching-squares contour of this SDF's zero level set: tangents
     /// perpendicular to the gradient, curves checked by |SDF|.
     Field(&'a Sdf),
     /// An exact smooth outline (a binary bitmap's, see
     /// [`crate::raster::binary`]): tangents given per vertex, curves checked
-    /// by their distance to the piece's own polyline.
-    Outline,
+    /// by their distance to the piece's own polyline, and, for a binary
+    /// bitmap's outline, by the bitmap's [`Corridor`]: then a curve may
+    /// stray up to [`Corridor::HALF_WIDTH`] further from the smooth outline
+    /// as long as it stays within the accuracy of the corridor.
+    Outline(Option<&'a Corridor>),
 }
 
 /// One piece of a closed contour between corners (or the whole contour),
 /// parameterized by normalized arc length.
-struct Piece<'a> {
+pub(super) struct Piece<'a> {
     pts: Vec<Point>,
     /// Unit tangent at each vertex ([`Guide::Outline`] only, else empty).
     tangents: Vec<Vec2>,
@@ -62,10 +67,14 @@ struct Piece<'a> {
     /// The fitter sees coordinates relative to this point: kurbo's moment
     /// integrals lose precision far from the origin.
     origin: Vec2,
+    /// Prefix sums of the exact area and moment integrals of the polyline's
+    /// segments (relative to `origin`), for [`Guide::Outline`]; empty for
+    /// SDF contours, which keep kurbo's quadrature.
+    moments: Vec<[f64; 3]>,
 }
 
 impl<'a> Piece<'a> {
-    fn new(
+    pub(super) fn new(
         pts: Vec<Point>,
         tangents: Vec<Vec2>,
         guide: Guide<'a>,
@@ -80,6 +89,22 @@ impl<'a> Piece<'a> {
             cum.push(s);
         }
         let origin = pts.first().map(|p| p.to_vec2()).unwrap_or_default();
+        let moments = match guide {
+            Guide::Outline(_) => {
+                let mut acc = [0.0; 3];
+                let mut m = Vec::with_capacity(pts.len());
+                m.push(acc);
+                for w in pts.windows(2) {
+                    let s = segment_moments(w[0] - origin, w[1] - origin);
+                    for k in 0..3 {
+                        acc[k] += s[k];
+                    }
+                    m.push(acc);
+                }
+                m
+            }
+            Guide::Field(_) => Vec::new(),
+        };
         Piece {
             pts,
             tangents,
@@ -88,10 +113,36 @@ impl<'a> Piece<'a> {
             corner_start,
             corner_end,
             origin,
+            moments,
         }
     }
 
-    fn length(&self) -> f64 {
+    /// How far (px) from the piece's own polyline a curve within
+    /// `accuracy` of what it is fitted to may lie: `accuracy`, plus the
+    /// corridor's half-width when a corridor decides.
+    fn reach(&self, accuracy: f64) -> f64 {
+        match self.guide {
+            Guide::Outline(Some(_)) => accuracy + Corridor::HALF_WIDTH,
+            _ => accuracy,
+        }
+    }
+
+    /// Number of vertices.
+    pub(super) fn len(&self) -> usize {
+        self.pts.len()
+    }
+
+    /// Arc length (px) from the first vertex to vertex `i`.
+    pub(super) fn arc_at(&self, i: usize) -> f64 {
+        self.cum[i]
+    }
+
+    /// Vertex `i`.
+    pub(super) fn point(&self, i: usize) -> Point {
+        self.pts[i]
+    }
+
+    pub(super) fn length(&self) -> f64 {
         *self.cum.last().unwrap_or(&0.0)
     }
 
@@ -136,7 +187,7 @@ impl<'a> Piece<'a> {
                 let mut pts = pts;
                 pts.all(|p| sdf.value(p).abs() <= limit)
             }
-            Guide::Outline => {
+            Guide::Outline(corridor) => {
                 let lo = self.locate(s0 - 1.0).0;
                 let hi = self.locate(s1 + 1.0).0;
                 let dist = |j: usize, p: Point| {
@@ -145,22 +196,31 @@ impl<'a> Piece<'a> {
                         kurbo::Line::new(self.pts[j], self.pts[j + 1]),
                     )
                 };
-                let limit = limit + OUTLINE_SLACK;
+                // Within `limit` of the outline; or, with a corridor, within
+                // `limit` of it and its half-width further from the outline
+                // (where the outline itself leaves the corridor, the first
+                // test still holds the curve to it).
+                let near = limit + OUTLINE_SLACK;
+                let far = self.reach(limit) + OUTLINE_SLACK;
                 // Consecutive points are usually near the same segment: try
                 // the last one found first.
                 let mut cursor = lo;
-                let mut pts = pts;
-                pts.all(|p| {
-                    if dist(cursor, p) <= limit {
+                let mut within = |p: Point, d: f64| {
+                    if dist(cursor, p) <= d {
                         return true;
                     }
-                    match (lo..=hi).find(|&j| dist(j, p) <= limit) {
+                    match (lo..=hi).find(|&j| dist(j, p) <= d) {
                         Some(j) => {
                             cursor = j;
                             true
                         }
                         None => false,
                     }
+                };
+                let mut pts = pts;
+                pts.all(|p| {
+                    within(p, near)
+                        || corridor.is_some_and(|c| c.reaches(p, limit) && within(p, far))
                 })
             }
         }
@@ -224,7 +284,7 @@ impl ParamCurveFit for Piece<'_> {
         let near_start = self.corner_start && s < CORNER_REACH;
         let near_end = self.corner_end && len - s < CORNER_REACH;
         let given = match self.guide {
-            Guide::Outline => self.given_tangent(i, s),
+            Guide::Outline(_) => self.given_tangent(i, s),
             Guide::Field(_) => None,
         };
         let tangent = if (at_start && self.corner_start) || (at_end && self.corner_end) {
@@ -266,10 +326,61 @@ impl ParamCurveFit for Piece<'_> {
         (p - self.origin, self.seg_dir(i) * self.length())
     }
 
+    fn moment_integrals(&self, range: Range<f64>) -> (f64, f64, f64) {
+        if self.moments.len() != self.pts.len() {
+            return self.quadrature_moments(range);
+        }
+        // Exact: the integrals of y dx, x y dx and y² dx over the polyline,
+        // partial segments at both ends and prefix sums between.
+        let len = self.length();
+        let (i0, p0) = self.locate(range.start * len);
+        let (i1, p1) = self.locate(range.end * len);
+        let o = self.origin;
+        let m = if i0 == i1 {
+            segment_moments(p0 - o, p1 - o)
+        } else {
+            let a = segment_moments(p0 - o, self.pts[i0 + 1] - o);
+            let b = segment_moments(self.pts[i1] - o, p1 - o);
+            let (lo, hi) = (self.moments[i0 + 1], self.moments[i1]);
+            [0, 1, 2].map(|k| a[k] + (hi[k] - lo[k]) + b[k])
+        };
+        (m[0], m[1], m[2])
+    }
+
     fn break_cusp(&self, _range: Range<f64>) -> Option<f64> {
         // Corners were cut before fitting.
         None
     }
+}
+
+impl Piece<'_> {
+    /// kurbo's default moment integrals (16-point Gauss–Legendre on the
+    /// derivative), kept for SDF contours so their output does not change.
+    fn quadrature_moments(&self, range: Range<f64>) -> (f64, f64, f64) {
+        let t0 = 0.5 * (range.start + range.end);
+        let dt = 0.5 * (range.end - range.start);
+        let (mut a, mut x, mut y) = (0.0, 0.0, 0.0);
+        for &(wi, xi) in kurbo::common::GAUSS_LEGENDRE_COEFFS_16 {
+            let (p, d) = self.sample_pt_deriv(t0 + xi * dt);
+            let ai = wi * d.x * p.y;
+            a += ai;
+            x += p.x * ai;
+            y += p.y * ai;
+        }
+        (a * dt, x * dt, y * dt)
+    }
+}
+
+/// The integrals ∫ y dx, ∫ x y dx and ∫ y² dx along the straight segment
+/// from `a` to `b` (what kurbo's fitter matches: signed area and its first
+/// moments, kurbo `ParamCurveFit::moment_integrals`).
+fn segment_moments(a: Point, b: Point) -> [f64; 3] {
+    let d = b - a;
+    [
+        d.x * (a.y + 0.5 * d.y),
+        d.x * (a.x * a.y + 0.5 * (a.x * d.y + a.y * d.x) + d.x * d.y / 3.0),
+        d.x * (a.y * a.y + a.y * d.y + d.y * d.y / 3.0),
+    ]
 }
 
 /// Indices of the corner vertices of a closed polygon: turning by more
@@ -348,26 +459,6 @@ pub fn fit_contour(pts: &[Point], sdf: &Sdf, accuracy: f64, out: &mut BezPath) {
     fit_loop(pts, &[], &corners(pts), Guide::Field(sdf), accuracy, out);
 }
 
-/// Fits a closed smooth outline (pixel coordinates) with cubic Béziers
-/// within `accuracy` px of it, appending a closed subpath to `out`:
-/// `tangents` are the outline's unit tangents at its points and `corners`
-/// the indices (ascending) where it turns sharply. This is the direct path
-/// for outlines known exactly (a binary bitmap's, see
-/// [`crate::raster::binary::SmoothLoop`]), with no SDF in between.
-pub fn fit_outline(
-    pts: &[Point],
-    tangents: &[Vec2],
-    corners: &[usize],
-    accuracy: f64,
-    out: &mut BezPath,
-) {
-    if pts.len() < 3 || tangents.len() != pts.len() {
-        return;
-    }
-    let corners: Vec<usize> = corners.iter().copied().filter(|&c| c < pts.len()).collect();
-    fit_loop(pts, tangents, &corners, Guide::Outline, accuracy, out);
-}
-
 /// The closed loop `pts` cut at `cs` into pieces, each fitted.
 fn fit_loop(
     pts: &[Point],
@@ -437,11 +528,11 @@ fn fit_loop(
     }
 }
 
-fn is_line(c: &CubicBez) -> bool {
+pub(super) fn is_line(c: &CubicBez) -> bool {
     c.p1 == c.p0.lerp(c.p3, 1.0 / 3.0) && c.p2 == c.p0.lerp(c.p3, 2.0 / 3.0)
 }
 
-fn line_cubic(a: Point, b: Point) -> CubicBez {
+pub(super) fn line_cubic(a: Point, b: Point) -> CubicBez {
     CubicBez::new(a, a.lerp(b, 1.0 / 3.0), a.lerp(b, 2.0 / 3.0), b)
 }
 
@@ -588,7 +679,7 @@ fn fit_piece(piece: &Piece, accuracy: f64, out: &mut Vec<CubicBez>) {
 /// [`CHORD_SHARE`] × `accuracy` of it (short
 /// spans of a noisy outline, where the end tangents disagree with the
 /// chord and no cubic passes, are usually this).
-fn fit_span(piece: &Piece, range: Range<f64>, accuracy: f64) -> Option<CubicBez> {
+pub(super) fn fit_span(piece: &Piece, range: Range<f64>, accuracy: f64) -> Option<CubicBez> {
     fit_checked(piece, range.clone(), accuracy).or_else(|| {
         let s0 = range.start * piece.length();
         let s1 = range.end * piece.length();
@@ -601,7 +692,8 @@ fn fit_span(piece: &Piece, range: Range<f64>, accuracy: f64) -> Option<CubicBez>
             .zip(&piece.pts)
             .filter(|(c, _)| **c > s0 && **c < s1)
             .all(|(_, &p)| {
-                crate::raster::sdf::point_segment_distance(p, chord) <= CHORD_SHARE * accuracy
+                crate::raster::sdf::point_segment_distance(p, chord)
+                    <= piece.reach(CHORD_SHARE * accuracy)
             });
         let on_level_set = || {
             piece.holds(
@@ -619,7 +711,7 @@ fn fit_span(piece: &Piece, range: Range<f64>, accuracy: f64) -> Option<CubicBez>
 const CHORD_SHARE: f64 = 0.6;
 
 /// Appends the piece's polygon over `range` as straight cubics.
-fn polygon(piece: &Piece, range: Range<f64>, out: &mut Vec<CubicBez>) {
+pub(super) fn polygon(piece: &Piece, range: Range<f64>, out: &mut Vec<CubicBez>) {
     let s0 = range.start * piece.length();
     let s1 = range.end * piece.length();
     let mut prev = piece.locate(s0).1;
@@ -637,7 +729,7 @@ fn polygon(piece: &Piece, range: Range<f64>, out: &mut Vec<CubicBez>) {
 
 /// Parameter span (of the piece's 0..1) below which a range is not split
 /// further but kept as a polygon.
-const MIN_SPAN_PX: f64 = 1.5;
+pub(super) const MIN_SPAN_PX: f64 = 1.5;
 
 /// One cubic for `range` of the piece, if kurbo finds one within `accuracy`
 /// that also stays within `accuracy` + [`CHECK_SLACK`] of the SDF's zero
@@ -648,7 +740,7 @@ fn fit_checked(piece: &Piece, range: Range<f64>, accuracy: f64) -> Option<CubicB
     if is_spicy(piece, range.clone()) {
         return None;
     }
-    let (c, _) = kurbo::fit_to_cubic(piece, range.clone(), accuracy)?;
+    let (c, _) = kurbo::fit_to_cubic(piece, range.clone(), piece.reach(accuracy))?;
     let c = Affine::translate(piece.origin) * c;
     let s0 = range.start * piece.length();
     let s1 = range.end * piece.length();
