@@ -36,18 +36,27 @@ impl Corridor {
     /// The corridor of binary coverage `cov` (ink where coverage ≥ ½).
     pub fn new(cov: &Coverage) -> Self {
         let (w, h) = (cov.width(), cov.height());
-        let ink = |x: isize, y: isize| -> bool {
-            x >= 0
-                && y >= 0
-                && (x as usize) < w
-                && (y as usize) < h
-                && cov.get(x as usize, y as usize) >= 0.5
-        };
-        let mixed = Grid::from_fn(w + 1, h + 1, |ci, cj| {
-            let (i, j) = (ci as isize - 1, cj as isize - 1);
-            let a = ink(i, j);
-            a != ink(i + 1, j) || a != ink(i, j + 1) || a != ink(i + 1, j + 1)
-        });
+        // Ink flags with a border of paper: padded (x + 1, y + 1) is pixel
+        // (x, y), so cell (ci, cj) has the padded corners (ci, cj) to
+        // (ci + 1, cj + 1).
+        let pw = w + 2;
+        let mut ink = vec![false; pw * (h + 2)];
+        if w > 0 {
+            for (y, row) in cov.data().chunks(w).enumerate() {
+                let start = (y + 1) * pw + 1;
+                for (flag, &c) in ink[start..start + row.len()].iter_mut().zip(row) {
+                    *flag = c >= 0.5;
+                }
+            }
+        }
+        let mut mixed = Vec::with_capacity((w + 1) * (h + 1));
+        for (top, bottom) in ink.chunks(pw).zip(ink.chunks(pw).skip(1)) {
+            for (t, b) in top.windows(2).zip(bottom.windows(2)) {
+                let a = t[0];
+                mixed.push(a != t[1] || a != b[0] || a != b[1]);
+            }
+        }
+        let mixed = Grid::from_vec(w + 1, h + 1, mixed).unwrap_or_else(|| Grid::new(0, 0, false));
         Corridor { mixed }
     }
 

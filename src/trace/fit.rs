@@ -202,20 +202,19 @@ impl<'a> Piece<'a> {
                 // test still holds the curve to it).
                 let near = limit + OUTLINE_SLACK;
                 let far = self.reach(limit) + OUTLINE_SLACK;
-                // Consecutive points are usually near the same segment: try
-                // the last one found first.
+                // Consecutive points are usually near the same segment or
+                // just ahead of it: search from the last one found onwards,
+                // then the rest.
                 let mut cursor = lo;
-                let mut within = |p: Point, d: f64| {
-                    if dist(cursor, p) <= d {
-                        return true;
+                let mut within = |p: Point, d: f64| match (cursor..=hi)
+                    .chain(lo..cursor)
+                    .find(|&j| dist(j, p) <= d)
+                {
+                    Some(j) => {
+                        cursor = j;
+                        true
                     }
-                    match (lo..=hi).find(|&j| dist(j, p) <= d) {
-                        Some(j) => {
-                            cursor = j;
-                            true
-                        }
-                        None => false,
-                    }
+                    None => false,
                 };
                 let mut pts = pts;
                 pts.all(|p| {
