@@ -167,12 +167,19 @@ pub fn trace_outline(
     opts: &TraceOptions,
 ) -> Vec<BezPath> {
     let polys: Vec<&[Point]> = loops.iter().map(|l| l.points.as_slice()).collect();
-    nest_polygons(&polys, opts.min_area)
+    let islands = nest_polygons(&polys, opts.min_area);
+    // Every loop is fitted on its own (in parallel: one island can hold
+    // most of the work), then the islands are assembled in order, so the
+    // output does not depend on the thread count.
+    let order: Vec<usize> = islands
+        .iter()
+        .flat_map(|(outer, holes)| std::iter::once(*outer).chain(holes.iter().copied()))
+        .collect();
+    let fitted: Vec<BezPath> = order
         .par_iter()
-        .map(|(outer, holes)| {
+        .map(|&i| {
             let mut path = BezPath::new();
-            for &i in std::iter::once(outer).chain(holes) {
-                let l = &loops[i];
+            if let Some(l) = loops.get(i) {
                 cover::fit_outline(
                     &l.points,
                     &l.tangents,
@@ -181,6 +188,17 @@ pub fn trace_outline(
                     corridor,
                     &mut path,
                 );
+            }
+            path
+        })
+        .collect();
+    let mut fitted = fitted.into_iter();
+    islands
+        .iter()
+        .map(|(_, holes)| {
+            let mut path = BezPath::new();
+            for p in fitted.by_ref().take(1 + holes.len()) {
+                path.extend(p);
             }
             path
         })
