@@ -156,6 +156,9 @@ pub fn extract(values: &Grid<f32>) -> Vec<Contour> {
     }
     let inside = |x: i32, y: i32| padded[(y + 1) as usize * pw + (x + 1) as usize];
     let mut next = vec![NONE; index.count()];
+    // The links given a successor, so the walk below visits only them (in
+    // id order, as a sweep over all links would).
+    let mut used = Vec::new();
     // Cells are indexed by their top-left sample (x, y), x in -1..w, y in -1..h.
     for y in -1..h {
         for x in -1..w {
@@ -219,13 +222,16 @@ pub fn extract(values: &Grid<f32>) -> Vec<Contour> {
                         .find(|&k| !corner[k] && corner[(k + 1) % 4])
                         .unwrap_or(e)
                 };
-                next[index.id(edges[e])] = index.id(edges[partner]) as u32;
+                let id = index.id(edges[e]);
+                next[id] = index.id(edges[partner]) as u32;
+                used.push(id);
             }
         }
     }
     let mut contours = Vec::new();
     let mut seen = vec![false; next.len()];
-    for start in 0..next.len() {
+    used.sort_unstable();
+    for &start in &used {
         if next[start] == NONE || seen[start] {
             continue;
         }
