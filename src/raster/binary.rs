@@ -645,10 +645,10 @@ fn corner_mask(l: &SmoothLoop) -> Vec<bool> {
 
 /// A closed polygon that follows an outline closely (an anti-aliased
 /// bitmap's sub-pixel outline) as a [`SmoothLoop`]: corners where it turns
-/// sharply within a pixel or so ([`crate::trace::fit::corners`]), chord
+/// sharply within a pixel or so ([`crate::trace::corner::corners`]), chord
 /// tangents elsewhere.
 pub fn polygon_loop(points: Vec<Point>) -> SmoothLoop {
-    let corners = crate::trace::fit::corners(&points);
+    let corners = crate::trace::corner::corners(&points);
     let n = points.len();
     let tangents = (0..n)
         .map(|i| unit(points[(i + 1) % n] - points[i]))

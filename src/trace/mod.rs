@@ -11,6 +11,7 @@
 //! flourish measures it against potrace (`make bench`).
 
 pub mod contour;
+pub mod corner;
 pub mod cover;
 pub mod fit;
 
