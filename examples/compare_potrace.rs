@@ -24,7 +24,15 @@ fn main() {
     if args.first().map(String::as_str) == Some("--explain") {
         let name = args.get(1).expect("--explain NAME.png OUTDIR");
         let dir = std::path::PathBuf::from(args.get(2).map(String::as_str).unwrap_or("."));
-        explain(name, &dir);
+        let at = match (args.get(3), args.get(4)) {
+            (Some(x), Some(y)) => Some(kurbo::Point::new(
+                x.parse().expect("X"),
+                y.parse().expect("Y"),
+            )),
+            _ => None,
+        };
+        let half: f64 = args.get(5).and_then(|h| h.parse().ok()).unwrap_or(24.0);
+        explain(name, &dir, at, half);
         return;
     }
     let runs: usize = args.first().and_then(|s| s.parse().ok()).unwrap_or(5);
@@ -72,12 +80,13 @@ fn main() {
     );
 }
 
-/// `--explain NAME.png OUTDIR`: where each tracer deviates most. Prints the
-/// worst points of both directions and the truth regions missed by more
-/// than 1.5 px, and writes 8× magnified crops around them
-/// (`OUTDIR/NAME-K.png`: input bitmap grey, truth green, flourish red,
-/// potrace blue).
-fn explain(name: &str, dir: &std::path::Path) {
+/// `--explain NAME.png OUTDIR [X Y [HALF]]`: where each tracer deviates most.
+/// Prints the worst points of both directions and the truth regions missed
+/// by more than 1.5 px, and writes 8× magnified crops around them (or only
+/// around (X, Y) when given, HALF px either side, default 24) (`OUTDIR/NAME-K.png`: input bitmap grey, truth
+/// green, flourish red, potrace blue, each tracer's on-curve nodes as dots
+/// of its colour).
+fn explain(name: &str, dir: &std::path::Path, at: Option<kurbo::Point>, half: f64) {
     use kurbo::{Point, Rect};
     use resvg::tiny_skia;
     std::fs::create_dir_all(dir).unwrap();
@@ -106,11 +115,20 @@ fn explain(name: &str, dir: &std::path::Path) {
             spots.push((format!("{label} missed {d:.2}"), *p));
         }
     }
+    if let Some(p) = at {
+        spots = vec![("requested".to_string(), p)];
+    }
+    let nodes = |paths: &[kurbo::BezPath]| -> Vec<Point> {
+        paths
+            .iter()
+            .flat_map(|p| p.segments().map(|s| kurbo::ParamCurve::start(&s)))
+            .collect()
+    };
+    let (nodes_f, nodes_p) = (nodes(&fpaths), nodes(&ppaths));
     let flat_f = support::flatten_paths(&fpaths);
     let flat_p = support::flatten_paths(&ppaths);
     for (k, (label, c)) in spots.iter().enumerate() {
-        let z = 8.0f32;
-        let half = 24.0;
+        let z = (192.0 / half) as f32;
         let view = Rect::new(c.x - half, c.y - half, c.x + half, c.y + half);
         let side = (2.0 * half as f32 * z) as u32;
         let mut pm = tiny_skia::Pixmap::new(side, side).unwrap();
@@ -166,6 +184,21 @@ fn explain(name: &str, dir: &std::path::Path) {
                     tiny_skia::Transform::identity(),
                     None,
                 );
+            }
+        }
+        for (pts, rgb) in [(&nodes_f, (220, 0, 0)), (&nodes_p, (0, 0, 255))] {
+            let mut paint = tiny_skia::Paint::default();
+            paint.set_color_rgba8(rgb.0, rgb.1, rgb.2, 255);
+            for p in pts.iter().filter(|p| view.contains(**p)) {
+                let r = tiny_skia::Rect::from_xywh(
+                    ((p.x - view.x0) as f32) * z - 4.0,
+                    ((p.y - view.y0) as f32) * z - 4.0,
+                    8.0,
+                    8.0,
+                );
+                if let Some(r) = r {
+                    pm.fill_rect(r, &paint, tiny_skia::Transform::identity(), None);
+                }
             }
         }
         let out = dir.join(format!("{name}-{k}.png"));

@@ -20,10 +20,12 @@ const BINARY_SAMPLES: [&str; 4] = [
 ];
 
 /// The target: at least as accurate and as compact as potrace on
-/// every binary sample. Not met yet (flourish has 1.3–6× potrace's
-/// segments, and drops diagonal one-pixel lines); run with `--ignored`.
+/// every binary sample. Not met yet (flourish has 1.05–1.16× potrace's
+/// segments on the binary glyph and scroll and 1.9× on the binary thin
+/// lines, and its symmetric deviation on the 2 Mpx ornament is larger at
+/// the default speck size); run with `--ignored`.
 #[test]
-#[ignore = "target not yet met: segment counts 1.3-6x potrace's; see README benchmark table"]
+#[ignore = "target not yet met on every sample: segments 0.75-1.9x potrace's; see README benchmark table"]
 fn flourish_beats_potrace_on_binary_samples() {
     if !support::potrace_available() {
         let msg =
@@ -88,8 +90,9 @@ const DEVIATION_ALLOWANCE: f64 = 0.2;
 /// What holds today, guarded against regressions: flourish's curves stay
 /// as close to the true outline as potrace's (within
 /// [`DEVIATION_ALLOWANCE`]), its render matches the input bitmap at least
-/// as well as potrace's, and it uses at most 1.5× potrace's segments over
-/// the binary samples.
+/// as well as potrace's, it uses no more segments than potrace over the
+/// binary samples, and at most 0.8× potrace's on the 2 Mpx ornament (the
+/// issue's target).
 #[test]
 fn flourish_stays_level_with_potrace() {
     if !support::potrace_available() {
@@ -115,6 +118,14 @@ fn flourish_stays_level_with_potrace() {
         );
         ours += c.flourish_segments;
         theirs += c.potrace_segments;
+        if name == "ornament-2mp.png" {
+            assert!(
+                c.flourish_segments * 5 <= c.potrace_segments * 4,
+                "{name}: {} segments, potrace {}: more than 0.8×",
+                c.flourish_segments,
+                c.potrace_segments
+            );
+        }
         assert!(
             c.flourish_dev_dir.0 <= c.potrace_dev_dir.0 + DEVIATION_ALLOWANCE,
             "{name}: flourish strays {:.3} px from the outline, potrace {:.3}",
@@ -129,8 +140,8 @@ fn flourish_stays_level_with_potrace() {
         );
     }
     assert!(
-        ours * 2 <= theirs * 3,
-        "{ours} segments, potrace {theirs}: more than 1.5×"
+        ours <= theirs,
+        "{ours} segments, potrace {theirs}: more than potrace"
     );
 }
 

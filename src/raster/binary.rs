@@ -519,7 +519,7 @@ fn smooth_polygon(v: &[Point]) -> SmoothLoop {
         let m1 = a.midpoint(p);
         let m2 = p.midpoint(b);
         let alpha = corner_alpha(a, p, b);
-        if alpha >= ALPHA_MAX {
+        if alpha >= ALPHA_MAX || is_line_end(a, p, b) {
             push(&mut out, m1, unit(p - a), false);
             push(&mut out, p, unit(b - p), true);
         } else {
@@ -645,10 +645,10 @@ fn corner_mask(l: &SmoothLoop) -> Vec<bool> {
 
 /// A closed polygon that follows an outline closely (an anti-aliased
 /// bitmap's sub-pixel outline) as a [`SmoothLoop`]: corners where it turns
-/// sharply within a pixel or so ([`crate::trace::fit::corners`]), chord
+/// sharply within a pixel or so ([`crate::trace::corner::corners`]), chord
 /// tangents elsewhere.
 pub fn polygon_loop(points: Vec<Point>) -> SmoothLoop {
-    let corners = crate::trace::fit::corners(&points);
+    let corners = crate::trace::corner::corners(&points);
     let n = points.len();
     let tangents = (0..n)
         .map(|i| unit(points[(i + 1) % n] - points[i]))
@@ -718,6 +718,22 @@ fn smooth_tangents(l: &mut SmoothLoop) {
         })
         .collect();
     l.tangents = tangents;
+}
+
+/// Longest edge (px) that can be the end of a thin line.
+const LINE_END_EDGE: f64 = 1.5;
+
+/// Whether polygon vertex `p` (between `a` and `b`) is a corner of a thin
+/// line's end: one of its edges at most [`LINE_END_EDGE`] long and the
+/// outline turning there by more than 80°. potrace's corner measure reads
+/// such a vertex as smooth (it sticks out of the chord to the far end of
+/// the line by less than a pixel) and the curve then rounds the line's end
+/// off over half its length; the bitmap says the line runs to its end.
+fn is_line_end(a: Point, p: Point, b: Point) -> bool {
+    let (u, w) = (p - a, b - p);
+    let short = u.hypot().min(w.hypot()) <= LINE_END_EDGE;
+    let turn = u.cross(w).atan2(u.dot(w)).abs();
+    short && turn > 80f64.to_radians()
 }
 
 /// Potrace's corner measure: how far the vertex `p` sticks out of the line

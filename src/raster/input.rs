@@ -134,6 +134,10 @@ pub struct OutlineInk {
     pub color: Color,
     /// The outline's closed loops, in pixel coordinates.
     pub loops: Vec<super::binary::SmoothLoop>,
+    /// For a binary bitmap, where its edge may lie: curves fitted to the
+    /// loops may use this band instead of hugging them. None for an
+    /// anti-aliased bitmap, whose outline is known to a fraction of a pixel.
+    pub corridor: Option<super::corridor::Corridor>,
 }
 
 /// Reads `path` for tracing: like [`load`], except that a binary bitmap
@@ -149,6 +153,7 @@ pub fn load_traceable(path: &Path, opts: &InputOptions) -> Result<Traceable> {
             height: h as f64,
             color,
             loops: super::binary::smooth_loops(&cov),
+            corridor: Some(super::corridor::Corridor::new(&cov)),
         })),
         // One anti-aliased layer: its sub-pixel outline, fitted directly.
         RasterCoverage::Layers { w, h, layers } if layers.len() == 1 && !opts.layers => {
@@ -162,6 +167,7 @@ pub fn load_traceable(path: &Path, opts: &InputOptions) -> Result<Traceable> {
                     .filter(|p| p.len() >= 3)
                     .map(super::binary::polygon_loop)
                     .collect(),
+                corridor: None,
             }))
         }
         other => Ok(Traceable::Field(other.into_ink())),
@@ -227,7 +233,11 @@ pub fn load_raster(path: &Path, bytes: &[u8], opts: &InputOptions) -> Result<Ink
 /// Decodes raster bytes into ink coverage: alpha or darkness, one layer or
 /// quantized colour layers.
 fn raster_coverage(path: &Path, bytes: &[u8], opts: &InputOptions) -> Result<RasterCoverage> {
-    let img = decode_raster(path, bytes)?.to_rgba8();
+    let img = decode_raster(path, bytes)?;
+    if let (image::DynamicImage::ImageLuma8(grey), false) = (&img, opts.layers) {
+        return Ok(grey_coverage(grey, opts.invert));
+    }
+    let img = img.to_rgba8();
     let (w, h) = (img.width() as usize, img.height() as usize);
     let has_alpha = img.pixels().any(|p| p[3] < 255);
     let px: Vec<[u8; 4]> = img.pixels().map(|p| p.0).collect();
@@ -270,6 +280,47 @@ fn raster_coverage(path: &Path, bytes: &[u8], opts: &InputOptions) -> Result<Ras
                 layers: vec![(color, cov)],
             }
         })
+    }
+}
+
+/// [`raster_coverage`] of an 8-bit grey image without a colour copy: the
+/// same coverage (darkness through [`luma`], so byte for byte what the RGBA
+/// path gives) and the same mean ink colour, grey.
+fn grey_coverage(grey: &image::GrayImage, invert: bool) -> RasterCoverage {
+    let (w, h) = (grey.width() as usize, grey.height() as usize);
+    // Coverage of each of the 256 grey levels, computed once.
+    let level: [f32; 256] = std::array::from_fn(|v| {
+        let g = v as u8;
+        let c = 1.0 - luma(&[g, g, g, 255]);
+        if invert {
+            1.0 - c
+        } else {
+            c
+        }
+    });
+    let raw = grey.as_raw();
+    let cov = Grid::from_fn(w, h, |x, y| {
+        raw.get(y * w + x).map_or(0.0, |&v| level[usize::from(v)])
+    });
+    let (mut sum, mut n) = (0u64, 0u64);
+    for (&v, &c) in raw.iter().zip(cov.data()) {
+        if c > 0.95 {
+            sum += v as u64;
+            n += 1;
+        }
+    }
+    let color = sum.checked_div(n).map_or(Color::BLACK, |g| {
+        let g = g as u8;
+        Color::rgb(g, g, g)
+    });
+    if super::binary::is_binary(&cov) {
+        RasterCoverage::Binary { w, h, color, cov }
+    } else {
+        RasterCoverage::Layers {
+            w,
+            h,
+            layers: vec![(color, cov)],
+        }
     }
 }
 

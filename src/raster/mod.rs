@@ -3,6 +3,7 @@
 //! tracer), and loading of raster and SVG inputs as ink coverage.
 
 pub mod binary;
+pub mod corridor;
 pub mod edt;
 pub mod input;
 pub mod plain;

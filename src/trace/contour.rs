@@ -144,8 +144,21 @@ pub fn extract(values: &Grid<f32>) -> Vec<Contour> {
         return Vec::new();
     }
     let index = LinkIndex { w, h };
-    let inside = |x: i32, y: i32| values.get_or(x as isize, y as isize, 1.0) < 0.0;
+    // Inside flags with a one-sample border of outside, so each cell's four
+    // corners are plain lookups (x, y from -1).
+    let pw = w as usize + 2;
+    let mut padded = vec![false; pw * (h as usize + 2)];
+    for (y, row) in values.data().chunks(w as usize).enumerate() {
+        let start = (y + 1) * pw + 1;
+        for (flag, &v) in padded[start..start + row.len()].iter_mut().zip(row) {
+            *flag = v < 0.0;
+        }
+    }
+    let inside = |x: i32, y: i32| padded[(y + 1) as usize * pw + (x + 1) as usize];
     let mut next = vec![NONE; index.count()];
+    // The links given a successor, so the walk below visits only them (in
+    // id order, as a sweep over all links would).
+    let mut used = Vec::new();
     // Cells are indexed by their top-left sample (x, y), x in -1..w, y in -1..h.
     for y in -1..h {
         for x in -1..w {
@@ -209,13 +222,16 @@ pub fn extract(values: &Grid<f32>) -> Vec<Contour> {
                         .find(|&k| !corner[k] && corner[(k + 1) % 4])
                         .unwrap_or(e)
                 };
-                next[index.id(edges[e])] = index.id(edges[partner]) as u32;
+                let id = index.id(edges[e]);
+                next[id] = index.id(edges[partner]) as u32;
+                used.push(id);
             }
         }
     }
     let mut contours = Vec::new();
     let mut seen = vec![false; next.len()];
-    for start in 0..next.len() {
+    used.sort_unstable();
+    for &start in &used {
         if next[start] == NONE || seen[start] {
             continue;
         }

@@ -6,30 +6,21 @@
 //! tangents perpendicular to the SDF gradient, which is smooth where the
 //! outline is, so pieces join with G1 continuity. `fit_to_bezpath_opt`
 //! then finds the fewest cubics within the tolerance. An outline known
-//! exactly (a binary bitmap's smoothed outline) is fitted the same way by
-//! [`fit_outline`], with its own tangents and corners, and each curve is
-//! checked against the outline itself instead of an SDF. Corners are the
+//! exactly (a bitmap's smoothed or sub-pixel outline) is fitted with the
+//! same [`Piece`] source by [`super::cover`], with its own tangents and
+//! corners, exact moment integrals, and each curve checked against the
+//! outline itself (and a binary bitmap's corridor) instead of an SDF. Corners are the
 //! vertices where the outline turns sharply within a pixel-scale window;
 //! the curves meet there at an angle, so sharp corners stay sharp.
 
+use super::corner::corners;
+use crate::raster::corridor::Corridor;
 use crate::raster::Sdf;
 use kurbo::{
     Affine, BezPath, CubicBez, CurveFitSample, ParamCurve, ParamCurveArclen, ParamCurveFit, Point,
     Vec2,
 };
 use std::ops::Range;
-
-/// Half-width in pixels of the window over which turning is measured when
-/// looking for corners.
-const CORNER_WINDOW: f64 = 1.25;
-
-/// Turning (radians) above which a vertex is a corner: 55°.
-const CORNER_ANGLE: f64 = 55.0 * std::f64::consts::PI / 180.0;
-
-/// Corners closer than this (px) along the outline are one corner (the
-/// sharper one): less than a pixel, so both corners of a 1-px line's end
-/// survive.
-const CORNER_SEPARATION: f64 = 0.9;
 
 /// Distance (px) from a corner within which tangents come from the polygon
 /// instead of the SDF gradient.
@@ -38,19 +29,22 @@ const CORNER_REACH: f64 = 1.5;
 /// What a piece is fitted to: where its tangents come from and what the
 /// fitted curves are checked against.
 #[derive(Clone, Copy)]
-enum Guide<'a> {
+pub(super) enum Guide<'a> {
     /// A marching-squares contour of this SDF's zero level set: tangents
     /// perpendicular to the gradient, curves checked by |SDF|.
     Field(&'a Sdf),
     /// An exact smooth outline (a binary bitmap's, see
     /// [`crate::raster::binary`]): tangents given per vertex, curves checked
-    /// by their distance to the piece's own polyline.
-    Outline,
+    /// by their distance to the piece's own polyline, and, for a binary
+    /// bitmap's outline, by the bitmap's [`Corridor`]: then a curve may
+    /// stray up to [`Corridor::HALF_WIDTH`] further from the smooth outline
+    /// as long as it stays within the accuracy of the corridor.
+    Outline(Option<&'a Corridor>),
 }
 
 /// One piece of a closed contour between corners (or the whole contour),
 /// parameterized by normalized arc length.
-struct Piece<'a> {
+pub(super) struct Piece<'a> {
     pts: Vec<Point>,
     /// Unit tangent at each vertex ([`Guide::Outline`] only, else empty).
     tangents: Vec<Vec2>,
@@ -62,10 +56,14 @@ struct Piece<'a> {
     /// The fitter sees coordinates relative to this point: kurbo's moment
     /// integrals lose precision far from the origin.
     origin: Vec2,
+    /// Prefix sums of the exact area and moment integrals of the polyline's
+    /// segments (relative to `origin`), for [`Guide::Outline`]; empty for
+    /// SDF contours, which keep kurbo's quadrature.
+    moments: Vec<[f64; 3]>,
 }
 
 impl<'a> Piece<'a> {
-    fn new(
+    pub(super) fn new(
         pts: Vec<Point>,
         tangents: Vec<Vec2>,
         guide: Guide<'a>,
@@ -80,6 +78,22 @@ impl<'a> Piece<'a> {
             cum.push(s);
         }
         let origin = pts.first().map(|p| p.to_vec2()).unwrap_or_default();
+        let moments = match guide {
+            Guide::Outline(_) => {
+                let mut acc = [0.0; 3];
+                let mut m = Vec::with_capacity(pts.len());
+                m.push(acc);
+                for w in pts.windows(2) {
+                    let s = segment_moments(w[0] - origin, w[1] - origin);
+                    for k in 0..3 {
+                        acc[k] += s[k];
+                    }
+                    m.push(acc);
+                }
+                m
+            }
+            Guide::Field(_) => Vec::new(),
+        };
         Piece {
             pts,
             tangents,
@@ -88,10 +102,36 @@ impl<'a> Piece<'a> {
             corner_start,
             corner_end,
             origin,
+            moments,
         }
     }
 
-    fn length(&self) -> f64 {
+    /// How far (px) from the piece's own polyline a curve within
+    /// `accuracy` of what it is fitted to may lie: `accuracy`, plus the
+    /// corridor's half-width when a corridor decides.
+    fn reach(&self, accuracy: f64) -> f64 {
+        match self.guide {
+            Guide::Outline(Some(_)) => accuracy + Corridor::HALF_WIDTH,
+            _ => accuracy,
+        }
+    }
+
+    /// Number of vertices.
+    pub(super) fn len(&self) -> usize {
+        self.pts.len()
+    }
+
+    /// Arc length (px) from the first vertex to vertex `i`.
+    pub(super) fn arc_at(&self, i: usize) -> f64 {
+        self.cum[i]
+    }
+
+    /// Vertex `i`.
+    pub(super) fn point(&self, i: usize) -> Point {
+        self.pts[i]
+    }
+
+    pub(super) fn length(&self) -> f64 {
         *self.cum.last().unwrap_or(&0.0)
     }
 
@@ -136,7 +176,7 @@ impl<'a> Piece<'a> {
                 let mut pts = pts;
                 pts.all(|p| sdf.value(p).abs() <= limit)
             }
-            Guide::Outline => {
+            Guide::Outline(corridor) => {
                 let lo = self.locate(s0 - 1.0).0;
                 let hi = self.locate(s1 + 1.0).0;
                 let dist = |j: usize, p: Point| {
@@ -145,22 +185,30 @@ impl<'a> Piece<'a> {
                         kurbo::Line::new(self.pts[j], self.pts[j + 1]),
                     )
                 };
-                let limit = limit + OUTLINE_SLACK;
-                // Consecutive points are usually near the same segment: try
-                // the last one found first.
+                // Within `limit` of the outline; or, with a corridor, within
+                // `limit` of it and its half-width further from the outline
+                // (where the outline itself leaves the corridor, the first
+                // test still holds the curve to it).
+                let near = limit + OUTLINE_SLACK;
+                let far = self.reach(limit) + OUTLINE_SLACK;
+                // Consecutive points are usually near the same segment or
+                // just ahead of it: search from the last one found onwards,
+                // then the rest.
                 let mut cursor = lo;
+                let mut within = |p: Point, d: f64| match (cursor..=hi)
+                    .chain(lo..cursor)
+                    .find(|&j| dist(j, p) <= d)
+                {
+                    Some(j) => {
+                        cursor = j;
+                        true
+                    }
+                    None => false,
+                };
                 let mut pts = pts;
                 pts.all(|p| {
-                    if dist(cursor, p) <= limit {
-                        return true;
-                    }
-                    match (lo..=hi).find(|&j| dist(j, p) <= limit) {
-                        Some(j) => {
-                            cursor = j;
-                            true
-                        }
-                        None => false,
-                    }
+                    within(p, near)
+                        || corridor.is_some_and(|c| c.reaches(p, limit) && within(p, far))
                 })
             }
         }
@@ -224,7 +272,7 @@ impl ParamCurveFit for Piece<'_> {
         let near_start = self.corner_start && s < CORNER_REACH;
         let near_end = self.corner_end && len - s < CORNER_REACH;
         let given = match self.guide {
-            Guide::Outline => self.given_tangent(i, s),
+            Guide::Outline(_) => self.given_tangent(i, s),
             Guide::Field(_) => None,
         };
         let tangent = if (at_start && self.corner_start) || (at_end && self.corner_end) {
@@ -266,76 +314,61 @@ impl ParamCurveFit for Piece<'_> {
         (p - self.origin, self.seg_dir(i) * self.length())
     }
 
+    fn moment_integrals(&self, range: Range<f64>) -> (f64, f64, f64) {
+        if self.moments.len() != self.pts.len() {
+            return self.quadrature_moments(range);
+        }
+        // Exact: the integrals of y dx, x y dx and y² dx over the polyline,
+        // partial segments at both ends and prefix sums between.
+        let len = self.length();
+        let (i0, p0) = self.locate(range.start * len);
+        let (i1, p1) = self.locate(range.end * len);
+        let o = self.origin;
+        let m = if i0 == i1 {
+            segment_moments(p0 - o, p1 - o)
+        } else {
+            let a = segment_moments(p0 - o, self.pts[i0 + 1] - o);
+            let b = segment_moments(self.pts[i1] - o, p1 - o);
+            let (lo, hi) = (self.moments[i0 + 1], self.moments[i1]);
+            [0, 1, 2].map(|k| a[k] + (hi[k] - lo[k]) + b[k])
+        };
+        (m[0], m[1], m[2])
+    }
+
     fn break_cusp(&self, _range: Range<f64>) -> Option<f64> {
         // Corners were cut before fitting.
         None
     }
 }
 
-/// Indices of the corner vertices of a closed polygon: turning by more
-/// than [`CORNER_ANGLE`] within ±[`CORNER_WINDOW`] px, the sharpest vertex
-/// of each such stretch.
-pub fn corners(pts: &[Point]) -> Vec<usize> {
-    let n = pts.len();
-    if n < 4 {
-        return Vec::new();
-    }
-    let mut cum = Vec::with_capacity(n + 1);
-    let mut s = 0.0;
-    cum.push(0.0);
-    for i in 0..n {
-        s += (pts[(i + 1) % n] - pts[i]).hypot();
-        cum.push(s);
-    }
-    let total = s;
-    if total < 4.0 * CORNER_WINDOW {
-        return Vec::new();
-    }
-    // Point at arc length s along the closed polygon (wrapping).
-    let at = |s: f64| -> Point {
-        let s = s.rem_euclid(total);
-        let i = match cum.binary_search_by(|c: &f64| c.total_cmp(&s)) {
-            Ok(i) => i.min(n - 1),
-            Err(i) => i.saturating_sub(1).min(n - 1),
-        };
-        let seg = cum[i + 1] - cum[i];
-        let t = if seg > 0.0 { (s - cum[i]) / seg } else { 0.0 };
-        pts[i].lerp(pts[(i + 1) % n], t)
-    };
-    let turn: Vec<f64> = (0..n)
-        .map(|i| {
-            let p = pts[i];
-            let a = p - at(cum[i] - CORNER_WINDOW);
-            let b = at(cum[i] + CORNER_WINDOW) - p;
-            a.cross(b).atan2(a.dot(b)).abs()
-        })
-        .collect();
-    let mut out = Vec::new();
-    for i in 0..n {
-        if turn[i] < CORNER_ANGLE {
-            continue;
+impl Piece<'_> {
+    /// kurbo's default moment integrals (16-point Gauss–Legendre on the
+    /// derivative), kept for SDF contours so their output does not change.
+    fn quadrature_moments(&self, range: Range<f64>) -> (f64, f64, f64) {
+        let t0 = 0.5 * (range.start + range.end);
+        let dt = 0.5 * (range.end - range.start);
+        let (mut a, mut x, mut y) = (0.0, 0.0, 0.0);
+        for &(wi, xi) in kurbo::common::GAUSS_LEGENDRE_COEFFS_16 {
+            let (p, d) = self.sample_pt_deriv(t0 + xi * dt);
+            let ai = wi * d.x * p.y;
+            a += ai;
+            x += p.x * ai;
+            y += p.y * ai;
         }
-        // Local maximum within the window (ties broken by index).
-        let mut is_max = true;
-        let mut j = (i + 1) % n;
-        while j != i && (cum[j] - cum[i]).rem_euclid(total) < CORNER_SEPARATION {
-            if turn[j] > turn[i] {
-                is_max = false;
-            }
-            j = (j + 1) % n;
-        }
-        let mut j = (i + n - 1) % n;
-        while j != i && (cum[i] - cum[j]).rem_euclid(total) < CORNER_SEPARATION {
-            if turn[j] >= turn[i] {
-                is_max = false;
-            }
-            j = (j + n - 1) % n;
-        }
-        if is_max {
-            out.push(i);
-        }
+        (a * dt, x * dt, y * dt)
     }
-    out
+}
+
+/// The integrals ∫ y dx, ∫ x y dx and ∫ y² dx along the straight segment
+/// from `a` to `b` (what kurbo's fitter matches: signed area and its first
+/// moments, kurbo `ParamCurveFit::moment_integrals`).
+fn segment_moments(a: Point, b: Point) -> [f64; 3] {
+    let d = b - a;
+    [
+        d.x * (a.y + 0.5 * d.y),
+        d.x * (a.x * a.y + 0.5 * (a.x * d.y + a.y * d.x) + d.x * d.y / 3.0),
+        d.x * (a.y * a.y + a.y * d.y + d.y * d.y / 3.0),
+    ]
 }
 
 /// Fits a closed contour (pixel coordinates) of `sdf`'s zero level set with
@@ -345,46 +378,13 @@ pub fn fit_contour(pts: &[Point], sdf: &Sdf, accuracy: f64, out: &mut BezPath) {
     if pts.len() < 3 {
         return;
     }
-    fit_loop(pts, &[], &corners(pts), Guide::Field(sdf), accuracy, out);
+    fit_loop(pts, &corners(pts), sdf, accuracy, out);
 }
 
-/// Fits a closed smooth outline (pixel coordinates) with cubic Béziers
-/// within `accuracy` px of it, appending a closed subpath to `out`:
-/// `tangents` are the outline's unit tangents at its points and `corners`
-/// the indices (ascending) where it turns sharply. This is the direct path
-/// for outlines known exactly (a binary bitmap's, see
-/// [`crate::raster::binary::SmoothLoop`]), with no SDF in between.
-pub fn fit_outline(
-    pts: &[Point],
-    tangents: &[Vec2],
-    corners: &[usize],
-    accuracy: f64,
-    out: &mut BezPath,
-) {
-    if pts.len() < 3 || tangents.len() != pts.len() {
-        return;
-    }
-    let corners: Vec<usize> = corners.iter().copied().filter(|&c| c < pts.len()).collect();
-    fit_loop(pts, tangents, &corners, Guide::Outline, accuracy, out);
-}
-
-/// The closed loop `pts` cut at `cs` into pieces, each fitted.
-fn fit_loop(
-    pts: &[Point],
-    tangents: &[Vec2],
-    cs: &[usize],
-    guide: Guide,
-    accuracy: f64,
-    out: &mut BezPath,
-) {
+/// The closed contour `pts` of `sdf` cut at `cs` into pieces, each fitted.
+fn fit_loop(pts: &[Point], cs: &[usize], sdf: &Sdf, accuracy: f64, out: &mut BezPath) {
     let n = pts.len();
-    let tan_of = |idx: &[usize]| -> Vec<Vec2> {
-        if tangents.is_empty() {
-            Vec::new()
-        } else {
-            idx.iter().map(|&i| tangents[i]).collect()
-        }
-    };
+    let guide = Guide::Field(sdf);
     let mut pieces: Vec<Piece> = Vec::new();
     if cs.is_empty() {
         // A smooth loop is fitted as two open halves (kurbo's fitter needs
@@ -395,7 +395,7 @@ fn fit_loop(
         let second: Vec<usize> = (h..n).chain([0]).collect();
         for idx in [first, second] {
             let p = idx.iter().map(|&i| pts[i]).collect();
-            pieces.push(Piece::new(p, tan_of(&idx), guide, false, false));
+            pieces.push(Piece::new(p, Vec::new(), guide, false, false));
         }
     } else {
         for k in 0..cs.len() {
@@ -411,7 +411,7 @@ fn fit_loop(
                 i = (i + 1) % n;
             }
             let p = idx.iter().map(|&i| pts[i]).collect();
-            pieces.push(Piece::new(p, tan_of(&idx), guide, true, true));
+            pieces.push(Piece::new(p, Vec::new(), guide, true, true));
         }
     }
     let mut first = true;
@@ -437,11 +437,11 @@ fn fit_loop(
     }
 }
 
-fn is_line(c: &CubicBez) -> bool {
+pub(super) fn is_line(c: &CubicBez) -> bool {
     c.p1 == c.p0.lerp(c.p3, 1.0 / 3.0) && c.p2 == c.p0.lerp(c.p3, 2.0 / 3.0)
 }
 
-fn line_cubic(a: Point, b: Point) -> CubicBez {
+pub(super) fn line_cubic(a: Point, b: Point) -> CubicBez {
     CubicBez::new(a, a.lerp(b, 1.0 / 3.0), a.lerp(b, 2.0 / 3.0), b)
 }
 
@@ -588,7 +588,7 @@ fn fit_piece(piece: &Piece, accuracy: f64, out: &mut Vec<CubicBez>) {
 /// [`CHORD_SHARE`] × `accuracy` of it (short
 /// spans of a noisy outline, where the end tangents disagree with the
 /// chord and no cubic passes, are usually this).
-fn fit_span(piece: &Piece, range: Range<f64>, accuracy: f64) -> Option<CubicBez> {
+pub(super) fn fit_span(piece: &Piece, range: Range<f64>, accuracy: f64) -> Option<CubicBez> {
     fit_checked(piece, range.clone(), accuracy).or_else(|| {
         let s0 = range.start * piece.length();
         let s1 = range.end * piece.length();
@@ -601,7 +601,8 @@ fn fit_span(piece: &Piece, range: Range<f64>, accuracy: f64) -> Option<CubicBez>
             .zip(&piece.pts)
             .filter(|(c, _)| **c > s0 && **c < s1)
             .all(|(_, &p)| {
-                crate::raster::sdf::point_segment_distance(p, chord) <= CHORD_SHARE * accuracy
+                crate::raster::sdf::point_segment_distance(p, chord)
+                    <= piece.reach(CHORD_SHARE * accuracy)
             });
         let on_level_set = || {
             piece.holds(
@@ -619,7 +620,7 @@ fn fit_span(piece: &Piece, range: Range<f64>, accuracy: f64) -> Option<CubicBez>
 const CHORD_SHARE: f64 = 0.6;
 
 /// Appends the piece's polygon over `range` as straight cubics.
-fn polygon(piece: &Piece, range: Range<f64>, out: &mut Vec<CubicBez>) {
+pub(super) fn polygon(piece: &Piece, range: Range<f64>, out: &mut Vec<CubicBez>) {
     let s0 = range.start * piece.length();
     let s1 = range.end * piece.length();
     let mut prev = piece.locate(s0).1;
@@ -637,7 +638,7 @@ fn polygon(piece: &Piece, range: Range<f64>, out: &mut Vec<CubicBez>) {
 
 /// Parameter span (of the piece's 0..1) below which a range is not split
 /// further but kept as a polygon.
-const MIN_SPAN_PX: f64 = 1.5;
+pub(super) const MIN_SPAN_PX: f64 = 1.5;
 
 /// One cubic for `range` of the piece, if kurbo finds one within `accuracy`
 /// that also stays within `accuracy` + [`CHECK_SLACK`] of the SDF's zero
@@ -648,7 +649,7 @@ fn fit_checked(piece: &Piece, range: Range<f64>, accuracy: f64) -> Option<CubicB
     if is_spicy(piece, range.clone()) {
         return None;
     }
-    let (c, _) = kurbo::fit_to_cubic(piece, range.clone(), accuracy)?;
+    let (c, _) = kurbo::fit_to_cubic(piece, range.clone(), piece.reach(accuracy))?;
     let c = Affine::translate(piece.origin) * c;
     let s0 = range.start * piece.length();
     let s1 = range.end * piece.length();

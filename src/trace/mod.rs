@@ -11,10 +11,13 @@
 //! flourish measures it against potrace (`make bench`).
 
 pub mod contour;
+pub mod corner;
+pub mod cover;
 pub mod fit;
 
 use crate::error::{Error, Result};
 use crate::raster::binary::SmoothLoop;
+use crate::raster::corridor::Corridor;
 use crate::raster::input::{self, Ink, InputOptions, Traceable};
 use crate::raster::Sdf;
 use crate::svg_out::{decimals_for, Color, Document, FillRule, Group, Shape};
@@ -153,25 +156,50 @@ pub fn trace_sdf(sdf: &Sdf, opts: &TraceOptions) -> Vec<BezPath> {
         .collect()
 }
 
-/// Traces a binary bitmap's smooth outline (see [`crate::raster::binary`])
-/// directly: one closed Bézier path per island, in pixel units. The curves
-/// stay within `opts.tolerance` of the outline itself, with no SDF and no
-/// second contour extraction in between.
-pub fn trace_outline(loops: &[SmoothLoop], opts: &TraceOptions) -> Vec<BezPath> {
+/// Traces a bitmap's outline (see [`crate::raster::binary`]) directly: one
+/// closed Bézier path per island, in pixel units, with no SDF and no second
+/// contour extraction in between. The curves stay within `opts.tolerance`
+/// of the outline itself, or, given a binary bitmap's `corridor`, within
+/// `opts.tolerance` of the corridor and [`Corridor::HALF_WIDTH`] +
+/// `opts.tolerance` of the outline ([`cover`]).
+pub fn trace_outline(
+    loops: &[SmoothLoop],
+    corridor: Option<&Corridor>,
+    opts: &TraceOptions,
+) -> Vec<BezPath> {
     let polys: Vec<&[Point]> = loops.iter().map(|l| l.points.as_slice()).collect();
-    nest_polygons(&polys, opts.min_area)
+    let islands = nest_polygons(&polys, opts.min_area);
+    // Every loop is fitted on its own (in parallel: one island can hold
+    // most of the work), then the islands are assembled in order, so the
+    // output does not depend on the thread count.
+    let order: Vec<usize> = islands
+        .iter()
+        .flat_map(|(outer, holes)| std::iter::once(*outer).chain(holes.iter().copied()))
+        .collect();
+    let fitted: Vec<BezPath> = order
         .par_iter()
-        .map(|(outer, holes)| {
+        .map(|&i| {
             let mut path = BezPath::new();
-            for &i in std::iter::once(outer).chain(holes) {
-                let l = &loops[i];
-                fit::fit_outline(
+            if let Some(l) = loops.get(i) {
+                cover::fit_outline(
                     &l.points,
                     &l.tangents,
                     &l.corners,
                     opts.tolerance,
+                    corridor,
                     &mut path,
                 );
+            }
+            path
+        })
+        .collect();
+    let mut fitted = fitted.into_iter();
+    islands
+        .iter()
+        .map(|(_, holes)| {
+            let mut path = BezPath::new();
+            for p in fitted.by_ref().take(1 + holes.len()) {
+                path.extend(p);
             }
             path
         })
@@ -223,8 +251,11 @@ pub fn trace_file(path: &Path, input: &InputOptions, opts: &TraceOptions) -> Res
         Traceable::Field(ink) => trace_ink(&ink, opts),
         Traceable::Outline(o) => {
             let mut doc = Document::new(o.width, o.height, decimals_for(opts.tolerance));
-            doc.groups
-                .extend(layer_group(0, trace_outline(&o.loops, opts), o.color));
+            doc.groups.extend(layer_group(
+                0,
+                trace_outline(&o.loops, o.corridor.as_ref(), opts),
+                o.color,
+            ));
             Ok(doc)
         }
     }

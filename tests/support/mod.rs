@@ -582,8 +582,9 @@ pub fn raw_segment_count(svg: &str) -> usize {
 }
 
 /// The trace options the comparison uses: the defaults, with the tolerance
-/// taken from `FLOURISH_TOLERANCE` (px) when that is set, so the example can
-/// show the segments/deviation trade-off.
+/// taken from `FLOURISH_TOLERANCE` (px) and the speck size from
+/// `FLOURISH_MIN_AREA` (px²) when those are set, so the example can show
+/// the trade-offs.
 pub fn flourish_options() -> TraceOptions {
     let mut o = TraceOptions::default();
     if let Some(t) = std::env::var("FLOURISH_TOLERANCE")
@@ -591,6 +592,12 @@ pub fn flourish_options() -> TraceOptions {
         .and_then(|v| v.parse::<f64>().ok())
     {
         o.tolerance = t;
+    }
+    if let Some(a) = std::env::var("FLOURISH_MIN_AREA")
+        .ok()
+        .and_then(|v| v.parse::<f64>().ok())
+    {
+        o.min_area = a;
     }
     o
 }

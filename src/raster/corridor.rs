@@ -1,0 +1,176 @@
+//! Where the edge a binary bitmap was rendered from can lie.
+//!
+//! A binary pixel only says on which side of the edge its centre is. So the
+//! edge passes between every ink centre and every paper centre next to it:
+//! through the cells whose corners are the centres of a 2×2 block of
+//! pixels of both colours ("mixed" cells), a band about one pixel wide
+//! around the staircase, and not through the centres themselves (it is
+//! kept [`Corridor::KEEP_OUT`] from them, so thin lines keep their width). Any curve inside that band renders (thresholded
+//! at the pixel centres) to the same bitmap. potrace's polygon stage reads
+//! the bitmap the same way: a straight path may pass anywhere within half a
+//! pixel of the boundary (Selinger 2003, §2.2.1), and its curve optimization
+//! only asks the curves to stay within a tolerance of that (§2.4).
+//!
+//! [`Corridor::reaches`] is the acceptance test the fitter uses for binary
+//! outlines ([`crate::trace::cover`]): a curve point is acceptable when a
+//! mixed cell lies within the tolerance of it.
+
+use super::{Coverage, Grid};
+use kurbo::Point;
+
+/// The mixed cells of a binary bitmap (see the module docs).
+#[derive(Clone, Debug)]
+pub struct Corridor {
+    /// `mixed[(i + 1, j + 1)]`: whether the cell between the centres of
+    /// pixels (i, j) and (i + 1, j + 1) has centres of both colours
+    /// (pixels outside the bitmap are paper); i, j from −1.
+    mixed: Grid<bool>,
+}
+
+impl Corridor {
+    /// How far (px) the corridor reaches to either side of the staircase
+    /// along the pixel axes: half a pixel, the whole uncertainty of a
+    /// binary edge.
+    pub const HALF_WIDTH: f64 = 0.5;
+
+    /// The corridor of binary coverage `cov` (ink where coverage ≥ ½).
+    pub fn new(cov: &Coverage) -> Self {
+        let (w, h) = (cov.width(), cov.height());
+        // Ink flags with a border of paper: padded (x + 1, y + 1) is pixel
+        // (x, y), so cell (ci, cj) has the padded corners (ci, cj) to
+        // (ci + 1, cj + 1).
+        let pw = w + 2;
+        let mut ink = vec![false; pw * (h + 2)];
+        if w > 0 {
+            for (y, row) in cov.data().chunks(w).enumerate() {
+                let start = (y + 1) * pw + 1;
+                for (flag, &c) in ink[start..start + row.len()].iter_mut().zip(row) {
+                    *flag = c >= 0.5;
+                }
+            }
+        }
+        let mut mixed = Vec::with_capacity((w + 1) * (h + 1));
+        for (top, bottom) in ink.chunks(pw).zip(ink.chunks(pw).skip(1)) {
+            for (t, b) in top.windows(2).zip(bottom.windows(2)) {
+                let a = t[0];
+                mixed.push(a != t[1] || a != b[0] || a != b[1]);
+            }
+        }
+        let mixed = Grid::from_vec(w + 1, h + 1, mixed).unwrap_or_else(|| Grid::new(0, 0, false));
+        Corridor { mixed }
+    }
+
+    /// How close (px) the edge may come to a pixel centre: it passes
+    /// between the centres, and keeping it half a pixel from them keeps a
+    /// one-pixel line at least a pixel wide and a one-pixel gap open.
+    pub const KEEP_OUT: f64 = 0.5;
+
+    /// Whether `p` (pixel coordinates) is within `reach` px of where the
+    /// edge may be: a mixed cell lies within `reach` of it (Euclidean), and
+    /// it is at least [`Self::KEEP_OUT`] − `reach` from every pixel centre.
+    pub fn reaches(&self, p: Point, reach: f64) -> bool {
+        if !(p.x.is_finite() && p.y.is_finite()) {
+            return false;
+        }
+        let reach = reach.max(0.0);
+        // Not within the keep-out of a pixel centre (the nearest one).
+        let c = Point::new((p.x - 0.5).round() + 0.5, (p.y - 0.5).round() + 0.5);
+        let keep = Self::KEEP_OUT - reach;
+        if keep > 0.0 && (p - c).hypot2() < keep * keep {
+            return false;
+        }
+        // Cell (ci, cj) spans x from ci − ½ to ci + ½ (centres of pixels
+        // ci − 1 and ci), likewise y.
+        let (w, h) = (self.mixed.width() as isize, self.mixed.height() as isize);
+        let lo = |v: f64| (v - reach + 0.5).floor() as isize;
+        let hi = |v: f64| (v + reach + 0.5).floor() as isize;
+        for cj in lo(p.y).max(0)..=hi(p.y).min(h - 1) {
+            for ci in lo(p.x).max(0)..=hi(p.x).min(w - 1) {
+                if !self.mixed.get(ci as usize, cj as usize) {
+                    continue;
+                }
+                let x0 = ci as f64 - 0.5;
+                let y0 = cj as f64 - 0.5;
+                let dx = (x0 - p.x).max(p.x - (x0 + 1.0)).max(0.0);
+                let dy = (y0 - p.y).max(p.y - (y0 + 1.0)).max(0.0);
+                if dx * dx + dy * dy <= reach * reach {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Brute force: the distance from `p` to the nearest mixed cell, from
+    /// pixel centres directly (infinite within the keep-out of a centre,
+    /// measured over every centre of the grid and around it).
+    fn brute(cov: &Coverage, p: Point, reach: f64) -> f64 {
+        let (w, h) = (cov.width() as isize, cov.height() as isize);
+        let ink = |x: isize, y: isize| {
+            x >= 0 && y >= 0 && x < w && y < h && cov.get(x as usize, y as usize) >= 0.5
+        };
+        let mut nearest_centre = f64::INFINITY;
+        for j in -3..h + 3 {
+            for i in -3..w + 3 {
+                let c = Point::new(i as f64 + 0.5, j as f64 + 0.5);
+                nearest_centre = nearest_centre.min((p - c).hypot());
+            }
+        }
+        if nearest_centre < Corridor::KEEP_OUT - reach {
+            return f64::INFINITY;
+        }
+        let mut best = f64::INFINITY;
+        for j in -1..h {
+            for i in -1..w {
+                let c = [ink(i, j), ink(i + 1, j), ink(i, j + 1), ink(i + 1, j + 1)];
+                if c.iter().all(|&v| v == c[0]) {
+                    continue;
+                }
+                // The cell spans the centres: x from i + ½ to i + 1½.
+                let (x0, y0) = (i as f64 + 0.5, j as f64 + 0.5);
+                let dx = (x0 - p.x).max(p.x - (x0 + 1.0)).max(0.0);
+                let dy = (y0 - p.y).max(p.y - (y0 + 1.0)).max(0.0);
+                best = best.min(dx.hypot(dy));
+            }
+        }
+        best
+    }
+
+    #[test]
+    fn reaches_agrees_with_brute_force() {
+        let cov = Grid::from_fn(12, 10, |x, y| {
+            let d = (x as f64 + 0.5 - 6.0).hypot(y as f64 + 0.5 - 5.0);
+            if d < 3.2 || (x == 1 && y == 8) {
+                1.0
+            } else {
+                0.0
+            }
+        });
+        let c = Corridor::new(&cov);
+        let mut seed = 12345u64;
+        let mut rnd = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..4000 {
+            let p = Point::new(rnd() * 14.0 - 1.0, rnd() * 12.0 - 1.0);
+            let reach = rnd() * 1.5;
+            let d = brute(&cov, p, reach);
+            // Away from the boundary of the test the answers agree.
+            if (d - reach).abs() > 1e-9 {
+                assert_eq!(c.reaches(p, reach), d <= reach, "{p:?} reach {reach} d {d}");
+            }
+        }
+        // The staircase itself (a pixel edge between ink and paper) is
+        // always inside, paper far away never.
+        assert!(c.reaches(Point::new(6.0, 5.0 - 3.0), 0.0));
+        assert!(!c.reaches(Point::new(11.5, 0.5), 0.3));
+    }
+}
