@@ -136,7 +136,10 @@ mod tests {
             }
             .to_string()
         };
-        assert_eq!(e(50_000, 20), "s.svg: 50000×20 px exceeds the size limit (L)");
+        assert_eq!(
+            e(50_000, 20),
+            "s.svg: 50000×20 px exceeds the size limit (L)"
+        );
         assert_eq!(
             e(u64::MAX, 3),
             "s.svg: a canvas of over 10¹⁹ px per side exceeds the size limit (L)"
