@@ -46,14 +46,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let k = 800.0 / sketch.width;
             let (w, h) = (800.0, sketch.height * k);
             let sketch_g = inner(&text).replace("stroke=\"#000\"", "stroke=\"#bbb\"");
-            rows.push_str(&format!(
-                "<g transform=\"translate(0 {y}) scale({k})\">{sketch_g}</g>\
-                 <g transform=\"translate({w} {y}) scale({k})\">{}</g>\
-                 <g transform=\"translate({} {y}) scale({k})\">{}</g>",
-                inner(&art.document.to_svg()),
-                2.0 * w,
-                inner(&fl.document.to_svg())
-            ));
+            // Each panel is a nested viewport: it clips what reaches past
+            // the sketch's own page, so panels never overlap.
+            let (sw, sh) = (sketch.width, sketch.height);
+            let panel = |x: f64, body: &str| {
+                format!(
+                    "<svg x=\"{x}\" y=\"{y}\" width=\"{w}\" height=\"{h}\" viewBox=\"0 0 {sw} {sh}\">{body}</svg>"
+                )
+            };
+            rows.push_str(&panel(0.0, &sketch_g));
+            rows.push_str(&panel(w, inner(&art.document.to_svg())));
+            rows.push_str(&panel(2.0 * w, inner(&fl.document.to_svg())));
             y += h;
             width = width.max(3.0 * w);
         }

@@ -133,9 +133,19 @@ fn ink_follows_each_query_and_has_no_debris() {
                 // No debris: no piece smaller than the exemplars' smallest,
                 // but for the body of a query shorter than every exemplar.
                 let largest = sizes.iter().copied().max().unwrap_or(0);
+                // Nothing cut flat on the canvas's edge: no ink in its
+                // outermost pixels (with a margin of one width, end curls
+                // and outer leaves were cut on 15 of the sample queries).
+                let (cw, ch) = (mask.width(), mask.height());
+                let on_border = (0..cw)
+                    .flat_map(|x| [(x, 0), (x, ch - 1)])
+                    .chain((0..ch).flat_map(|y| [(0, y), (cw - 1, y)]))
+                    .filter(|&(x, y)| mask.get(x, y))
+                    .count();
                 let name = format!("{s}-{st}/{}", r.spine.query_id);
-                eprintln!("{name}: coverage {frac:.3}, farthest ink {far:.2} widths, smallest component {smallest} px (exemplars {min})");
-                let ok = frac >= 0.95 && far <= 1.5 && smallest >= min.min(largest);
+                eprintln!("{name}: coverage {frac:.3}, farthest ink {far:.2} widths, smallest component {smallest} px (exemplars {min}), {on_border} ink px on the canvas border");
+                let ok =
+                    frac >= 0.95 && far <= 1.5 && smallest >= min.min(largest) && on_border == 0;
                 if !ok {
                     failures.push(name);
                 }

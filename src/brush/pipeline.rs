@@ -124,7 +124,9 @@ pub fn start_level(style: &BrushStyle, ew: f64) -> usize {
         .unwrap_or(e.levels.len().saturating_sub(1))
 }
 
-/// The canvas of a query spine: its bounding box grown by one stroke width,
+/// The canvas of a query spine: its bounding box grown by 1.5 stroke
+/// widths (the farthest an ornament may reach from its spine; with one
+/// width, end curls and outer leaves were cut flat on the canvas border),
 /// at `W_e / W_q` finest pixels per unit, a whole number of coarsest
 /// pixels; checked against the canvas limits before anything is allocated.
 pub fn canvas_for(q: &QuerySpine, ew: f64, factor: usize) -> Result<Canvas> {
@@ -134,7 +136,7 @@ pub fn canvas_for(q: &QuerySpine, ew: f64, factor: usize) -> Result<Canvas> {
         (x0, y0) = (x0.min(s.pos.x), y0.min(s.pos.y));
         (x1, y1) = (x1.max(s.pos.x), y1.max(s.pos.y));
     }
-    let m = q.width;
+    let m = 1.5 * q.width;
     let f = factor.max(1) as f64;
     let cw = ((x1 - x0 + 2.0 * m) * ppu / f).ceil();
     let ch = ((y1 - y0 + 2.0 * m) * ppu / f).ceil();

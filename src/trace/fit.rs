@@ -42,6 +42,37 @@ pub(super) enum Guide<'a> {
     Outline(Option<&'a Corridor>),
 }
 
+/// How far `p` (px) lies inside the canvas of `sdf`'s grid, negated: the
+/// signed distance of the canvas rectangle `[0, w] × [0, h]`, negative
+/// inside.
+fn canvas_value(sdf: &Sdf, p: Point) -> f64 {
+    let (w, h) = (sdf.width() as f64, sdf.height() as f64);
+    -(p.x.min(p.y).min(w - p.x).min(h - p.y))
+}
+
+/// The SDF of the ink clipped to the canvas, `max(Φ, canvas)`: marching
+/// squares close ink that runs off the canvas along its border (the grid is
+/// padded with outside samples), so that is the level set the contour
+/// follows there, and a curve along the border fits it exactly.
+fn clipped_value(sdf: &Sdf, p: Point) -> f64 {
+    sdf.value(p).max(canvas_value(sdf, p))
+}
+
+/// The gradient of [`clipped_value`]: the border's outward normal where
+/// the canvas term is the larger.
+fn clipped_gradient(sdf: &Sdf, p: Point) -> Vec2 {
+    let (w, h) = (sdf.width() as f64, sdf.height() as f64);
+    let c = canvas_value(sdf, p);
+    if c < sdf.value(p) {
+        return sdf.gradient(p);
+    }
+    let (ex, ey) = (Vec2::new(1.0, 0.0), Vec2::new(0.0, 1.0));
+    let d = [(p.x, -ex), (p.y, -ey), (w - p.x, ex), (h - p.y, ey)];
+    d.iter()
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map_or(Vec2::ZERO, |&(_, n)| n)
+}
+
 /// One piece of a closed contour between corners (or the whole contour),
 /// parameterized by normalized arc length.
 pub(super) struct Piece<'a> {
@@ -174,7 +205,7 @@ impl<'a> Piece<'a> {
             Guide::Field(sdf) => {
                 let limit = limit + CHECK_SLACK;
                 let mut pts = pts;
-                pts.all(|p| sdf.value(p).abs() <= limit)
+                pts.all(|p| clipped_value(sdf, p).abs() <= limit)
             }
             Guide::Outline(corridor) => {
                 let lo = self.locate(s0 - 1.0).0;
@@ -286,7 +317,7 @@ impl ParamCurveFit for Piece<'_> {
             // direction is the better tangent there.
             self.chord_dir(s, near_start)
         } else if let Guide::Field(sdf) = self.guide {
-            let g = sdf.gradient(p);
+            let g = clipped_gradient(sdf, p);
             let perp = Vec2::new(-g.y, g.x);
             let l = perp.hypot();
             if l > 1e-6 {
@@ -705,5 +736,31 @@ mod tests {
         fit_contour(&cs[0].points, &sdf, 0.25, &mut path);
         let n = crate::svg_out::count_segments(&path);
         assert!(n <= 8, "{n} segments");
+    }
+
+    #[test]
+    fn ink_running_off_the_canvas_is_closed_by_a_few_lines_on_the_border() {
+        // A disc centred on the canvas's top-left corner and one covering
+        // the whole canvas: the contour runs along the border, where the
+        // SDF is far from zero, and each border stretch must still be one
+        // segment (it was one per marching-squares edge: 800 for the
+        // full canvas).
+        for (cx, cy, r, most) in [(0.0, 0.0, 60.0, 8), (50.0, 50.0, 500.0, 12)] {
+            let sdf = disc_sdf(100, cx, cy, r);
+            let cs = contour::extract(&sdf.dist);
+            assert_eq!(cs.len(), 1);
+            let mut path = BezPath::new();
+            fit_contour(&cs[0].points, &sdf, 0.25, &mut path);
+            let n = crate::svg_out::count_segments(&path);
+            assert!(n <= most, "disc at ({cx}, {cy}) r {r}: {n} segments");
+            // And the curves follow the clipped level set.
+            for seg in path.segments() {
+                for k in 0..=20 {
+                    let p = seg.eval(k as f64 / 20.0);
+                    let v = clipped_value(&sdf, p);
+                    assert!(v.abs() <= 0.25 + CHECK_SLACK + 0.05, "{p:?}: {v}");
+                }
+            }
+        }
     }
 }
