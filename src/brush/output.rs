@@ -271,8 +271,16 @@ pub fn components(mask: &Grid<bool>) -> Vec<Vec<usize>> {
 /// default `min_area`: smaller ones are rasterization specks).
 pub const SPECK: usize = 4;
 
-/// The area (finest px²) of the smallest ink component of any exemplar of
-/// the style (specks under [`SPECK`] aside): ornament pieces smaller than
+/// How deep (px) inside its outline some pixel of a drawn element lies: a
+/// piece with no pixel centre a pixel from its edge is under 2 px thick
+/// everywhere, a fragment of a hairline tip broken up by rasterization
+/// (the scroll's tapering spikes leave 1–4 px dots at 512 px), not
+/// something the artist drew.
+pub const ELEMENT_DEPTH: f32 = 1.0;
+
+/// The area (finest px²) of the smallest drawn element of any exemplar of
+/// the style: a component of its ink of at least [`SPECK`] px² that is at
+/// least [`ELEMENT_DEPTH`] deep somewhere. Ornament pieces smaller than
 /// this are synthesis debris.
 pub fn smallest_exemplar_component(style: &BrushStyle) -> usize {
     style
@@ -280,8 +288,13 @@ pub fn smallest_exemplar_component(style: &BrushStyle) -> usize {
         .iter()
         .filter_map(|e| e.finest())
         .flat_map(|lv| {
-            components(&lv.ink.ink.map(|d| d < 0.0))
+            let sdf = &lv.ink.ink;
+            components(&sdf.map(|d| d < 0.0))
                 .into_iter()
+                .filter(|c| {
+                    c.iter()
+                        .any(|&i| sdf.data().get(i).is_some_and(|&d| d <= -ELEMENT_DEPTH))
+                })
                 .map(|c| c.len())
         })
         .filter(|&n| n >= SPECK)
