@@ -34,12 +34,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut tiles = String::new();
         for j in 0..3 {
             for i in 0..3 {
-                tiles += &format!(
-                    "<svg x=\"{}\" y=\"{}\" width=\"64\" height=\"64\" viewBox=\"0 0 64 64\">{}</svg>",
-                    i * 64,
-                    j * 64,
-                    inner(&tile)
-                );
+                tiles += &cell(i * 64, j * 64, 64, inner(&tile));
             }
         }
         let svg = format!(
@@ -67,12 +62,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             };
             let sketch_path = root.join(format!("samples/fill/{shape}.svg"));
             let result = run(&opts, &sketch_path)?.to_svg();
-            cells += &format!(
-                "<svg x=\"{}\" y=\"{}\" width=\"200\" height=\"200\" viewBox=\"0 0 200 200\">{}</svg>",
-                i * 200,
-                j * 200,
-                inner(&result)
-            );
+            cells += &cell(i * 200, j * 200, 200, inner(&result));
         }
     }
     let svg = format!(
@@ -81,6 +71,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
     write_png(&root.join("docs/fill-gallery.png"), &svg, w as u32)?;
     Ok(())
+}
+
+/// A square nested viewport of `size` units at `(x, y)` showing `body`
+/// drawn on a `size`-unit page.
+fn cell(x: usize, y: usize, size: usize, body: &str) -> String {
+    format!("<svg x=\"{x}\" y=\"{y}\" width=\"{size}\" height=\"{size}\" viewBox=\"0 0 {size} {size}\">{body}</svg>")
 }
 
 /// Renders SVG text `svg` at `width` px wide into the PNG file `out`.

@@ -131,6 +131,28 @@ pub enum DirectionToml {
     Named(String),
 }
 
+/// Checks a fill style's direction-like key: a finite non-zero `[x, y]` or
+/// the one accepted name.
+fn check_direction(
+    path: &Path,
+    key: &str,
+    value: &Option<DirectionToml>,
+    name: &str,
+) -> Result<()> {
+    let why = match value {
+        Some(DirectionToml::Vector(v))
+            if !(v[0].is_finite() && v[1].is_finite() && v[0].hypot(v[1]) > 1e-9) =>
+        {
+            format!("must be a non-zero vector, got {v:?}")
+        }
+        Some(DirectionToml::Named(n)) if n != name => {
+            format!("must be \"{name}\" or [x, y], got \"{n}\"")
+        }
+        _ => return Ok(()),
+    };
+    Err(Error::invalid(path, format!("{key}: {why}")))
+}
+
 /// Parses `style.toml` text; `path` names the file in errors.
 pub fn parse(path: &Path, text: &str) -> Result<StyleToml> {
     let parsed: StyleToml = toml::from_str(text).map_err(|e| {
@@ -268,34 +290,8 @@ impl StyleToml {
     /// The fill keys: ranges, and exactly one tile.
     fn validate_fill(&self, path: &Path) -> Result<()> {
         let bad = |key: &str, why: String| Err(Error::invalid(path, format!("{key}: {why}")));
-        match &self.direction {
-            Some(DirectionToml::Vector(v))
-                if !(v[0].is_finite() && v[1].is_finite() && v[0].hypot(v[1]) > 1e-9) =>
-            {
-                return bad("direction", format!("must be a non-zero vector, got {v:?}"));
-            }
-            Some(DirectionToml::Named(n)) if n != "etf" => {
-                return bad(
-                    "direction",
-                    format!("must be \"etf\" or [x, y], got \"{n}\""),
-                );
-            }
-            _ => {}
-        }
-        match &self.flow {
-            Some(DirectionToml::Vector(v))
-                if !(v[0].is_finite() && v[1].is_finite() && v[0].hypot(v[1]) > 1e-9) =>
-            {
-                return bad("flow", format!("must be a non-zero vector, got {v:?}"));
-            }
-            Some(DirectionToml::Named(n)) if n != "outline" => {
-                return bad(
-                    "flow",
-                    format!("must be \"outline\" or [x, y], got \"{n}\""),
-                );
-            }
-            _ => {}
-        }
+        check_direction(path, "direction", &self.direction, "etf")?;
+        check_direction(path, "flow", &self.flow, "outline")?;
         if let Some(p) = self.patch {
             if !(3..=33).contains(&p) || p % 2 == 0 {
                 return bad("patch", format!("must be odd and within 3..33 px, got {p}"));
