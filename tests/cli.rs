@@ -392,16 +392,15 @@ fn huge_declared_svg_canvas_is_capped_by_resolution() {
 #[test]
 fn svg_shapes_with_huge_coordinates_trace_quickly() {
     let t = tempdir();
-    let p = t.path().join("huge.svg");
-    std::fs::write(
-        &p,
+    let p = write(
+        t.path(),
+        "huge.svg",
         r#"<svg xmlns="http://www.w3.org/2000/svg" width="100" height="100">
 <circle cx="1e20" cy="5" r="1e19"/>
 <circle cx="50" cy="1e12" r="999999999950"/>
 <path d="M10 10 L 1e30 1e30 L 10 20Z"/>
 <rect x="20" y="20" width="10" height="10"/></svg>"#,
-    )
-    .unwrap();
+    );
     let out = t.path().join("out.svg");
     let (o, _) = flourish_timed(
         t.path(),
@@ -862,19 +861,11 @@ fn out_dir_is_made_when_missing_and_a_file_there_is_an_error() {
     let t = tempdir();
     let a = t.path().join("a.png");
     write_disc_png(&a, 16);
-    let outdir = t.path().join("new/svg");
-    let previews = t.path().join("new/png");
-    let o = flourish(&[
-        "trace",
-        s(&a),
-        "--out-dir",
-        s(&outdir),
-        "--preview",
-        s(&previews),
-    ]);
+    let (out, png) = (t.path().join("new/svg"), t.path().join("new/png"));
+    let o = flourish(&["trace", s(&a), "--out-dir", s(&out), "--preview", s(&png)]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    assert!(outdir.join("a.svg").is_file());
-    assert!(previews.join("a.png").is_file());
+    assert!(out.join("a.svg").is_file());
+    assert!(png.join("a.png").is_file());
     let file = t.path().join("taken");
     std::fs::write(&file, "keep").unwrap();
     let o = flourish(&["trace", s(&a), "--out-dir", s(&file)]);
