@@ -131,8 +131,6 @@ impl LinkIndex {
     }
 }
 
-const NONE: u32 = u32::MAX;
-
 /// Extracts the closed contours of `{v < 0}`. Samples beyond the grid count
 /// as outside, and a crossing into the padding is placed on the canvas
 /// border. Vertices are kept strictly inside their links (at least 0.001 px
@@ -155,7 +153,10 @@ pub fn extract(values: &Grid<f32>) -> Vec<Contour> {
         }
     }
     let inside = |x: i32, y: i32| padded[(y + 1) as usize * pw + (x + 1) as usize];
-    let mut next = vec![NONE; index.count()];
+    // `next[id]` is the successor's id + 1, 0 for none: a zeroed buffer
+    // is handed out by the allocator without a pass over it, and only the
+    // pages near the outline are ever touched.
+    let mut next = vec![0u32; index.count()];
     // The links given a successor, so the walk below visits only them (in
     // id order, as a sweep over all links would).
     let mut used = Vec::new();
@@ -223,7 +224,7 @@ pub fn extract(values: &Grid<f32>) -> Vec<Contour> {
                         .unwrap_or(e)
                 };
                 let id = index.id(edges[e]);
-                next[id] = index.id(edges[partner]) as u32;
+                next[id] = index.id(edges[partner]) as u32 + 1;
                 used.push(id);
             }
         }
@@ -232,15 +233,15 @@ pub fn extract(values: &Grid<f32>) -> Vec<Contour> {
     let mut seen = vec![false; next.len()];
     used.sort_unstable();
     for &start in &used {
-        if next[start] == NONE || seen[start] {
+        if next[start] == 0 || seen[start] {
             continue;
         }
         let mut links = Vec::new();
         let mut cur = start;
-        while !seen[cur] && next[cur] != NONE {
+        while !seen[cur] && next[cur] != 0 {
             seen[cur] = true;
             links.push(index.link(cur));
-            cur = next[cur] as usize;
+            cur = next[cur] as usize - 1;
         }
         let points = links.iter().map(|&l| crossing(values, l)).collect();
         contours.push(Contour { links, points });

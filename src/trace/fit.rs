@@ -210,39 +210,88 @@ impl<'a> Piece<'a> {
             Guide::Outline(corridor) => {
                 let lo = self.locate(s0 - 1.0).0;
                 let hi = self.locate(s1 + 1.0).0;
-                let dist = |j: usize, p: Point| {
-                    crate::raster::sdf::point_segment_distance(
-                        p,
-                        kurbo::Line::new(self.pts[j], self.pts[j + 1]),
-                    )
-                };
                 // Within `limit` of the outline; or, with a corridor, within
                 // `limit` of it and its half-width further from the outline
                 // (where the outline itself leaves the corridor, the first
                 // test still holds the curve to it).
                 let near = limit + OUTLINE_SLACK;
-                let far = self.reach(limit) + OUTLINE_SLACK;
+                let far = if corridor.is_some() {
+                    self.reach(limit) + OUTLINE_SLACK
+                } else {
+                    near
+                };
                 // Consecutive points are usually near the same segment or
                 // just ahead of it: search from the last one found onwards,
                 // then the rest.
                 let mut cursor = lo;
-                let mut within = |p: Point, d: f64| match (cursor..=hi)
-                    .chain(lo..cursor)
-                    .find(|&j| dist(j, p) <= d)
-                {
-                    Some(j) => {
-                        cursor = j;
-                        true
-                    }
-                    None => false,
-                };
                 let mut pts = pts;
                 pts.all(|p| {
-                    within(p, near)
-                        || corridor.is_some_and(|c| c.reaches(p, limit) && within(p, far))
+                    let (found, best) = match self.nearest_segment(p, cursor, hi, near, far) {
+                        (Some(j), d) => (Some(j), d),
+                        (None, d) if cursor > lo => {
+                            let (j, d2) = self.nearest_segment(p, lo, cursor - 1, near, far);
+                            (j, d.min(d2))
+                        }
+                        miss => miss,
+                    };
+                    if let Some(j) = found {
+                        cursor = j;
+                    }
+                    best <= near || best <= far && corridor.is_some_and(|c| c.reaches(p, limit))
                 })
             }
         }
+    }
+
+    /// Searches segments `from..=to` (clamped to the piece) for one within
+    /// `near` px of `p`, stopping at the first: returns it, or `None` and
+    /// the least distance (px) among the segments within `far` (≥ `near`),
+    /// infinity if none is. Segments that cannot come within `far` are
+    /// skipped by arc length: every point of segment `k ≥ j` is at most
+    /// `cum[k + 1] − cum[j]` from vertex `j` along the polyline, so it is at
+    /// least `|p − pts[j]| − (cum[k + 1] − cum[j])` from `p`.
+    fn nearest_segment(
+        &self,
+        p: Point,
+        from: usize,
+        to: usize,
+        near: f64,
+        far: f64,
+    ) -> (Option<usize>, f64) {
+        // Margin (px) for the rounding of the bound, far below any distance
+        // that matters.
+        const MARGIN: f64 = 1e-6;
+        let last = self.pts.len().saturating_sub(2);
+        let to = to.min(last);
+        let mut best = f64::INFINITY;
+        let mut j = from;
+        while j <= to && j < self.pts.len().saturating_sub(1) {
+            let reach = (p - self.pts[j]).hypot() - far - MARGIN;
+            if reach > 0.0 {
+                // Skip the segments ending less than `reach` further on.
+                let target = self.cum[j] + reach;
+                let mut k = j;
+                while k <= to && self.cum[k + 1] < target {
+                    k += 1;
+                }
+                if k > j {
+                    j = k;
+                    continue;
+                }
+            }
+            let d = crate::raster::sdf::point_segment_distance(
+                p,
+                kurbo::Line::new(self.pts[j], self.pts[j + 1]),
+            );
+            if d <= near {
+                return (Some(j), d);
+            }
+            if d <= far {
+                best = best.min(d);
+            }
+            j += 1;
+        }
+        (None, best)
     }
 
     /// Segment index and position at arc length `s`.
@@ -626,15 +675,13 @@ pub(super) fn fit_span(piece: &Piece, range: Range<f64>, accuracy: f64) -> Optio
         let a = piece.locate(s0).1;
         let b = piece.locate(s1).1;
         let chord = kurbo::Line::new(a, b);
-        let within = piece
-            .cum
-            .iter()
-            .zip(&piece.pts)
-            .filter(|(c, _)| **c > s0 && **c < s1)
-            .all(|(_, &p)| {
-                crate::raster::sdf::point_segment_distance(p, chord)
-                    <= piece.reach(CHORD_SHARE * accuracy)
-            });
+        // The vertices strictly inside (s0, s1): `cum` ascends.
+        let lo = piece.cum.partition_point(|&c| c <= s0);
+        let hi = piece.cum.partition_point(|&c| c < s1).max(lo);
+        let within = piece.pts[lo..hi].iter().all(|&p| {
+            crate::raster::sdf::point_segment_distance(p, chord)
+                <= piece.reach(CHORD_SHARE * accuracy)
+        });
         let on_level_set = || {
             piece.holds(
                 (1..64).map(|k| a.lerp(b, k as f64 / 64.0)),
