@@ -61,6 +61,24 @@ fn main() {
     let (t_all, _) = time(runs, || {
         trace::trace_file(&path, &input::InputOptions::default(), &opts).expect("trace")
     });
+    if std::env::var_os("TRACE_PHASES_LOOPS").is_some() {
+        let mut sizes: Vec<(f64, usize, usize)> = loops
+            .iter()
+            .map(|l| {
+                let t = Instant::now();
+                let _ = trace::trace_outline(std::slice::from_ref(l), Some(&corr), &opts);
+                (
+                    t.elapsed().as_secs_f64() * 1e3,
+                    l.points.len(),
+                    l.corners.len(),
+                )
+            })
+            .collect();
+        sizes.sort_by(|a, b| b.0.total_cmp(&a.0));
+        for (ms, n, c) in sizes.iter().take(8) {
+            println!("loop: {ms:.2} ms, {n} points, {c} corners");
+        }
+    }
     println!(
         "decode {t_decode:.1} ms, extract {t_extract:.1} ms, smooth_loops {t_loops:.1} ms, corridor {t_corr:.1} ms, fit {t_fit:.1} ms, trace_file {t_all:.1} ms ({} loops)",
         loops.len()
