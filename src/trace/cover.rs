@@ -221,3 +221,59 @@ fn cover_run(piece: &Piece, accuracy: f64, out: &mut Vec<CubicBez>) {
         start = good;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::fit::gallop;
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(200))]
+
+        /// The galloping search agrees with a plain binary search.
+        #[test]
+        fn gallop_is_partition_point(mut c in prop::collection::vec(0.0f64..100.0, 0..60), t in -1.0f64..101.0) {
+            c.sort_by(|a, b| a.total_cmp(b));
+            prop_assert_eq!(gallop(&c, t), c.partition_point(|&x| x < t));
+        }
+
+        /// The segment search with skips by arc length answers as a scan
+        /// of every segment does: one within `near`, else one within `far`.
+        #[test]
+        fn nearest_segment_matches_brute_force(
+            steps in prop::collection::vec((-3.0f64..3.0, -3.0f64..3.0), 2..80),
+            px in -20.0f64..20.0,
+            py in -20.0f64..20.0,
+            near in 0.05f64..1.0,
+            extra in 0.0f64..1.0,
+            from_share in 0.0f64..1.0,
+        ) {
+            let mut pts = vec![Point::ORIGIN];
+            for (dx, dy) in steps {
+                let last = pts[pts.len() - 1];
+                pts.push(last + Vec2::new(dx, dy));
+            }
+            let n = pts.len();
+            let piece = Piece::new(pts.clone(), vec![Vec2::new(1.0, 0.0); n], Guide::Outline(None), false, false);
+            let far = near + extra;
+            let p = Point::new(px, py);
+            let from = ((n - 2) as f64 * from_share) as usize;
+            let dists: Vec<f64> = (from..n - 1)
+                .map(|j| crate::raster::sdf::point_segment_distance(p, kurbo::Line::new(pts[j], pts[j + 1])))
+                .collect();
+            let (found, best) = piece.nearest_segment(p, from, n - 2, near, far);
+            match found {
+                Some(j) => {
+                    prop_assert!(j >= from && dists[j - from] <= near);
+                    prop_assert!(dists[..j - from].iter().all(|&d| d > near));
+                }
+                None => {
+                    prop_assert!(dists.iter().all(|&d| d > near));
+                    let any_far = dists.iter().any(|&d| d <= far);
+                    prop_assert_eq!(best <= far, any_far);
+                }
+            }
+        }
+    }
+}

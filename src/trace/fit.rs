@@ -245,12 +245,12 @@ impl<'a> Piece<'a> {
 
     /// Searches segments `from..=to` (clamped to the piece) for one within
     /// `near` px of `p`, stopping at the first: returns it, or `None` and
-    /// the least distance (px) among the segments within `far` (≥ `near`),
-    /// infinity if none is. Segments that cannot come within `far` are
-    /// skipped by arc length: every point of segment `k ≥ j` is at most
+    /// the distance (px) of a segment within `far` (≥ `near`), infinity if
+    /// none is. Segments that cannot come within `far` (once one is found:
+    /// within `near`) are skipped by arc length: every point of segment `k ≥ j` is at most
     /// `cum[k + 1] − cum[j]` from vertex `j` along the polyline, so it is at
     /// least `|p − pts[j]| − (cum[k + 1] − cum[j])` from `p`.
-    fn nearest_segment(
+    pub(super) fn nearest_segment(
         &self,
         p: Point,
         from: usize,
@@ -264,18 +264,18 @@ impl<'a> Piece<'a> {
         let last = self.pts.len().saturating_sub(2);
         let to = to.min(last);
         let mut best = f64::INFINITY;
+        // Once a segment within `far` is known only `near` matters.
+        let mut bound = far;
         let mut j = from;
         while j <= to && j < self.pts.len().saturating_sub(1) {
-            let reach = (p - self.pts[j]).hypot() - far - MARGIN;
+            let reach = (p - self.pts[j]).hypot() - bound - MARGIN;
             if reach > 0.0 {
-                // Skip the segments ending less than `reach` further on.
+                // Skip the segments ending less than `reach` further on
+                // (`cum` ascends).
                 let target = self.cum[j] + reach;
-                let mut k = j;
-                while k <= to && self.cum[k + 1] < target {
-                    k += 1;
-                }
-                if k > j {
-                    j = k;
+                let skip = self.cum.get(j + 1..to + 2).map_or(0, |c| gallop(c, target));
+                if skip > 0 {
+                    j += skip;
                     continue;
                 }
             }
@@ -288,6 +288,7 @@ impl<'a> Piece<'a> {
             }
             if d <= far {
                 best = best.min(d);
+                bound = near;
             }
             j += 1;
         }
@@ -661,6 +662,22 @@ fn fit_piece(piece: &Piece, accuracy: f64, out: &mut Vec<CubicBez>) {
         out.push(cubic);
         start = good;
     }
+}
+
+/// The number of leading values of ascending `c` below `target`, found by
+/// doubling steps and then bisecting: the skips in
+/// [`Piece::nearest_segment`] are mostly a few segments, now and then
+/// thousands.
+pub(super) fn gallop(c: &[f64], target: f64) -> usize {
+    let (mut lo, mut hi) = (0usize, 1usize);
+    while hi <= c.len() && c[hi - 1] < target {
+        lo = hi;
+        hi *= 2;
+    }
+    let hi = hi.min(c.len());
+    lo + c
+        .get(lo..hi)
+        .map_or(0, |c| c.partition_point(|&x| x < target))
 }
 
 /// One cubic for `range`: the fitted one if it passes [`fit_checked`], else
