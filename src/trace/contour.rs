@@ -248,18 +248,18 @@ pub fn extract(values: &Grid<f32>) -> Vec<Contour> {
         }
     }
     let mut contours = Vec::new();
-    let mut seen = vec![false; next.len()];
     used.sort_unstable();
     for &start in &used {
-        if next[start] == 0 || seen[start] {
+        if next[start] == 0 {
             continue;
         }
+        // A visited link's successor is cleared, which also marks it seen.
         let mut links = Vec::new();
         let mut cur = start;
-        while !seen[cur] && next[cur] != 0 {
-            seen[cur] = true;
+        while let Some(&succ) = next.get(cur).filter(|&&s| s != 0) {
+            next[cur] = 0;
             links.push(index.link(cur));
-            cur = next[cur] as usize - 1;
+            cur = succ as usize - 1;
         }
         let points = links.iter().map(|&l| crossing(values, l)).collect();
         contours.push(Contour { links, points });
