@@ -14,6 +14,7 @@
 //! the curves meet there at an angle, so sharp corners stay sharp.
 
 use super::corner::corners;
+use super::nearest::nearest_segment;
 use crate::raster::corridor::Corridor;
 use crate::raster::Sdf;
 use kurbo::{
@@ -226,14 +227,23 @@ impl<'a> Piece<'a> {
                 let mut cursor = lo;
                 let mut pts = pts;
                 pts.all(|p| {
-                    let (found, best) = match self.nearest_segment(p, cursor, hi, near, far) {
-                        (Some(j), d) => (Some(j), d),
-                        (None, d) if cursor > lo => {
-                            let (j, d2) = self.nearest_segment(p, lo, cursor - 1, near, far);
-                            (j, d.min(d2))
-                        }
-                        miss => miss,
-                    };
+                    let (found, best) =
+                        match nearest_segment(&self.pts, &self.cum, p, cursor, hi, near, far) {
+                            (Some(j), d) => (Some(j), d),
+                            (None, d) if cursor > lo => {
+                                let (j, d2) = nearest_segment(
+                                    &self.pts,
+                                    &self.cum,
+                                    p,
+                                    lo,
+                                    cursor - 1,
+                                    near,
+                                    far,
+                                );
+                                (j, d.min(d2))
+                            }
+                            miss => miss,
+                        };
                     if let Some(j) = found {
                         cursor = j;
                     }
@@ -241,58 +251,6 @@ impl<'a> Piece<'a> {
                 })
             }
         }
-    }
-
-    /// Searches segments `from..=to` (clamped to the piece) for one within
-    /// `near` px of `p`, stopping at the first: returns it, or `None` and
-    /// the distance (px) of a segment within `far` (≥ `near`), infinity if
-    /// none is. Segments that cannot come within `far` (once one is found:
-    /// within `near`) are skipped by arc length: every point of segment `k ≥ j` is at most
-    /// `cum[k + 1] − cum[j]` from vertex `j` along the polyline, so it is at
-    /// least `|p − pts[j]| − (cum[k + 1] − cum[j])` from `p`.
-    pub(super) fn nearest_segment(
-        &self,
-        p: Point,
-        from: usize,
-        to: usize,
-        near: f64,
-        far: f64,
-    ) -> (Option<usize>, f64) {
-        // Margin (px) for the rounding of the bound, far below any distance
-        // that matters.
-        const MARGIN: f64 = 1e-6;
-        let last = self.pts.len().saturating_sub(2);
-        let to = to.min(last);
-        let mut best = f64::INFINITY;
-        // Once a segment within `far` is known only `near` matters.
-        let mut bound = far;
-        let mut j = from;
-        while j <= to && j < self.pts.len().saturating_sub(1) {
-            let reach = (p - self.pts[j]).hypot() - bound - MARGIN;
-            if reach > 0.0 {
-                // Skip the segments ending less than `reach` further on
-                // (`cum` ascends).
-                let target = self.cum[j] + reach;
-                let skip = self.cum.get(j + 1..to + 2).map_or(0, |c| gallop(c, target));
-                if skip > 0 {
-                    j += skip;
-                    continue;
-                }
-            }
-            let d = crate::raster::sdf::point_segment_distance(
-                p,
-                kurbo::Line::new(self.pts[j], self.pts[j + 1]),
-            );
-            if d <= near {
-                return (Some(j), d);
-            }
-            if d <= far {
-                best = best.min(d);
-                bound = near;
-            }
-            j += 1;
-        }
-        (None, best)
     }
 
     /// Segment index and position at arc length `s`.
@@ -662,22 +620,6 @@ fn fit_piece(piece: &Piece, accuracy: f64, out: &mut Vec<CubicBez>) {
         out.push(cubic);
         start = good;
     }
-}
-
-/// The number of leading values of ascending `c` below `target`, found by
-/// doubling steps and then bisecting: the skips in
-/// [`Piece::nearest_segment`] are mostly a few segments, now and then
-/// thousands.
-pub(super) fn gallop(c: &[f64], target: f64) -> usize {
-    let (mut lo, mut hi) = (0usize, 1usize);
-    while hi <= c.len() && c[hi - 1] < target {
-        lo = hi;
-        hi *= 2;
-    }
-    let hi = hi.min(c.len());
-    lo + c
-        .get(lo..hi)
-        .map_or(0, |c| c.partition_point(|&x| x < target))
 }
 
 /// One cubic for `range`: the fitted one if it passes [`fit_checked`], else
