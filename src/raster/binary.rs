@@ -625,10 +625,18 @@ fn relax(l: &mut SmoothLoop) {
 /// The neighbour of vertex `j` on a closed loop of `n` vertices, ahead or
 /// behind.
 fn adjacent(j: usize, forward: bool, n: usize) -> usize {
+    // Compares, not `%`: this is the inner step of the relaxing and tangent
+    // walks, and an integer division costs more than the rest of a step.
     if forward {
-        (j + 1) % n
+        if j + 1 >= n {
+            0
+        } else {
+            j + 1
+        }
+    } else if j == 0 {
+        n.saturating_sub(1)
     } else {
-        (j + n - 1) % n
+        j - 1
     }
 }
 

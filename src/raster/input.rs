@@ -299,9 +299,12 @@ fn grey_coverage(grey: &image::GrayImage, invert: bool) -> RasterCoverage {
         }
     });
     let raw = grey.as_raw();
-    let cov = Grid::from_fn(w, h, |x, y| {
-        raw.get(y * w + x).map_or(0.0, |&v| level[usize::from(v)])
-    });
+    let cov = Grid::from_vec(w, h, raw.iter().map(|&v| level[usize::from(v)]).collect())
+        .unwrap_or_else(|| {
+            Grid::from_fn(w, h, |x, y| {
+                raw.get(y * w + x).map_or(0.0, |&v| level[usize::from(v)])
+            })
+        });
     let (mut sum, mut n) = (0u64, 0u64);
     for (&v, &c) in raw.iter().zip(cov.data()) {
         if c > 0.95 {

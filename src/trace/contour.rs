@@ -131,8 +131,6 @@ impl LinkIndex {
     }
 }
 
-const NONE: u32 = u32::MAX;
-
 /// Extracts the closed contours of `{v < 0}`. Samples beyond the grid count
 /// as outside, and a crossing into the padding is placed on the canvas
 /// border. Vertices are kept strictly inside their links (at least 0.001 px
@@ -147,25 +145,46 @@ pub fn extract(values: &Grid<f32>) -> Vec<Contour> {
     // Inside flags with a one-sample border of outside, so each cell's four
     // corners are plain lookups (x, y from -1).
     let pw = w as usize + 2;
-    let mut padded = vec![false; pw * (h as usize + 2)];
+    let mut padded = vec![0u8; pw * (h as usize + 2)];
     for (y, row) in values.data().chunks(w as usize).enumerate() {
         let start = (y + 1) * pw + 1;
         for (flag, &v) in padded[start..start + row.len()].iter_mut().zip(row) {
-            *flag = v < 0.0;
+            *flag = u8::from(v < 0.0);
         }
     }
-    let inside = |x: i32, y: i32| padded[(y + 1) as usize * pw + (x + 1) as usize];
-    let mut next = vec![NONE; index.count()];
+    // `next[id]` is the successor's id + 1, 0 for none: a zeroed buffer
+    // is handed out by the allocator without a pass over it, and only the
+    // pages near the outline are ever touched.
+    let mut next = vec![0u32; index.count()];
     // The links given a successor, so the walk below visits only them (in
     // id order, as a sweep over all links would).
     let mut used = Vec::new();
     // Cells are indexed by their top-left sample (x, y), x in -1..w, y in -1..h.
-    for y in -1..h {
-        for x in -1..w {
-            let a = inside(x, y);
-            let b = inside(x + 1, y);
-            let c = inside(x + 1, y + 1);
-            let d = inside(x, y + 1);
+    let rows = padded.chunks(pw).zip(padded.chunks(pw).skip(1));
+    for (yi, (top, bottom)) in rows.enumerate() {
+        let y = yi as i32 - 1;
+        let mut xi = 0usize;
+        while xi + 1 < pw {
+            // Eight cells at once where their nine samples in both rows
+            // are all inside or all outside (most of a drawing).
+            if let (Some(t), Some(b)) = (top.get(xi..xi + 9), bottom.get(xi..xi + 9)) {
+                let word = |s: &[u8]| {
+                    let mut a = [0u8; 8];
+                    a.copy_from_slice(&s[..8]);
+                    u64::from_le_bytes(a)
+                };
+                let (t0, t1, b0, b1) = (word(t), word(&t[1..]), word(b), word(&b[1..]));
+                if t0 == t1 && t0 == b0 && t0 == b1 && (t0 == 0 || t0 == 0x0101_0101_0101_0101) {
+                    xi += 8;
+                    continue;
+                }
+            }
+            let x = xi as i32 - 1;
+            let a = top[xi] != 0;
+            let b = top[xi + 1] != 0;
+            let c = bottom[xi + 1] != 0;
+            let d = bottom[xi] != 0;
+            xi += 1;
             let case = (a as u8) | (b as u8) << 1 | (c as u8) << 2 | (d as u8) << 3;
             if case == 0 || case == 15 {
                 continue;
@@ -223,24 +242,24 @@ pub fn extract(values: &Grid<f32>) -> Vec<Contour> {
                         .unwrap_or(e)
                 };
                 let id = index.id(edges[e]);
-                next[id] = index.id(edges[partner]) as u32;
+                next[id] = index.id(edges[partner]) as u32 + 1;
                 used.push(id);
             }
         }
     }
     let mut contours = Vec::new();
-    let mut seen = vec![false; next.len()];
     used.sort_unstable();
     for &start in &used {
-        if next[start] == NONE || seen[start] {
+        if next[start] == 0 {
             continue;
         }
+        // A visited link's successor is cleared, which also marks it seen.
         let mut links = Vec::new();
         let mut cur = start;
-        while !seen[cur] && next[cur] != NONE {
-            seen[cur] = true;
+        while let Some(&succ) = next.get(cur).filter(|&&s| s != 0) {
+            next[cur] = 0;
             links.push(index.link(cur));
-            cur = next[cur] as usize;
+            cur = succ as usize - 1;
         }
         let points = links.iter().map(|&l| crossing(values, l)).collect();
         contours.push(Contour { links, points });

@@ -20,6 +20,7 @@
 use super::fit::{fit_span, is_line, line_cubic, polygon, Guide, Piece, MIN_SPAN_PX};
 use crate::raster::corridor::Corridor;
 use kurbo::{BezPath, CubicBez, Point, Vec2};
+use rayon::prelude::*;
 
 /// Most turning (radians) one cubic is asked to follow: a half turn, about
 /// what one cubic without an inflection can follow closely (measured over
@@ -56,7 +57,6 @@ pub fn fit_outline(
     }
     let mut cs: Vec<usize> = corners.iter().copied().filter(|&c| c < n).collect();
     cs.dedup();
-    let mut cubics = Vec::new();
     let run = |idx: &[usize], corner: bool| {
         Piece::new(
             idx.iter().map(|&i| pts[i]).collect(),
@@ -66,27 +66,42 @@ pub fn fit_outline(
             corner,
         )
     };
-    if cs.is_empty() {
+    let cubics: Vec<CubicBez> = if cs.is_empty() {
         // A smooth loop is one run from its first point around to it again:
         // the end tangents are the same, so the seam is a G1 join.
         let idx: Vec<usize> = (0..n).chain([0]).collect();
+        let mut cubics = Vec::new();
         cover_run(&run(&idx, false), accuracy, &mut cubics);
+        cubics
     } else {
-        for k in 0..cs.len() {
-            let a = cs[k];
-            let b = cs[(k + 1) % cs.len()];
-            let mut idx = vec![a];
-            let mut i = (a + 1) % n;
-            loop {
-                idx.push(i);
-                if i == b {
-                    break;
+        // The runs between corners are independent: covered in parallel
+        // (a large loop holds most of a drawing's work), gathered in order.
+        let runs: Vec<Vec<usize>> = (0..cs.len())
+            .map(|k| {
+                let a = cs[k];
+                let b = cs[(k + 1) % cs.len()];
+                let mut idx = vec![a];
+                let mut i = (a + 1) % n;
+                loop {
+                    idx.push(i);
+                    if i == b {
+                        break;
+                    }
+                    i = (i + 1) % n;
                 }
-                i = (i + 1) % n;
-            }
-            cover_run(&run(&idx, true), accuracy, &mut cubics);
-        }
-    }
+                idx
+            })
+            .collect();
+        let covered: Vec<Vec<CubicBez>> = runs
+            .par_iter()
+            .map(|idx| {
+                let mut cubics = Vec::new();
+                cover_run(&run(idx, true), accuracy, &mut cubics);
+                cubics
+            })
+            .collect();
+        covered.into_iter().flatten().collect()
+    };
     let mut first = true;
     for c in cubics {
         if first {

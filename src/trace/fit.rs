@@ -14,6 +14,7 @@
 //! the curves meet there at an angle, so sharp corners stay sharp.
 
 use super::corner::corners;
+use super::nearest::nearest_segment;
 use crate::raster::corridor::Corridor;
 use crate::raster::Sdf;
 use kurbo::{
@@ -210,36 +211,43 @@ impl<'a> Piece<'a> {
             Guide::Outline(corridor) => {
                 let lo = self.locate(s0 - 1.0).0;
                 let hi = self.locate(s1 + 1.0).0;
-                let dist = |j: usize, p: Point| {
-                    crate::raster::sdf::point_segment_distance(
-                        p,
-                        kurbo::Line::new(self.pts[j], self.pts[j + 1]),
-                    )
-                };
                 // Within `limit` of the outline; or, with a corridor, within
                 // `limit` of it and its half-width further from the outline
                 // (where the outline itself leaves the corridor, the first
                 // test still holds the curve to it).
                 let near = limit + OUTLINE_SLACK;
-                let far = self.reach(limit) + OUTLINE_SLACK;
+                let far = if corridor.is_some() {
+                    self.reach(limit) + OUTLINE_SLACK
+                } else {
+                    near
+                };
                 // Consecutive points are usually near the same segment or
                 // just ahead of it: search from the last one found onwards,
                 // then the rest.
                 let mut cursor = lo;
-                let mut within = |p: Point, d: f64| match (cursor..=hi)
-                    .chain(lo..cursor)
-                    .find(|&j| dist(j, p) <= d)
-                {
-                    Some(j) => {
-                        cursor = j;
-                        true
-                    }
-                    None => false,
-                };
                 let mut pts = pts;
                 pts.all(|p| {
-                    within(p, near)
-                        || corridor.is_some_and(|c| c.reaches(p, limit) && within(p, far))
+                    let (found, best) =
+                        match nearest_segment(&self.pts, &self.cum, p, cursor, hi, near, far) {
+                            (Some(j), d) => (Some(j), d),
+                            (None, d) if cursor > lo => {
+                                let (j, d2) = nearest_segment(
+                                    &self.pts,
+                                    &self.cum,
+                                    p,
+                                    lo,
+                                    cursor - 1,
+                                    near,
+                                    far,
+                                );
+                                (j, d.min(d2))
+                            }
+                            miss => miss,
+                        };
+                    if let Some(j) = found {
+                        cursor = j;
+                    }
+                    best <= near || best <= far && corridor.is_some_and(|c| c.reaches(p, limit))
                 })
             }
         }
@@ -626,15 +634,13 @@ pub(super) fn fit_span(piece: &Piece, range: Range<f64>, accuracy: f64) -> Optio
         let a = piece.locate(s0).1;
         let b = piece.locate(s1).1;
         let chord = kurbo::Line::new(a, b);
-        let within = piece
-            .cum
-            .iter()
-            .zip(&piece.pts)
-            .filter(|(c, _)| **c > s0 && **c < s1)
-            .all(|(_, &p)| {
-                crate::raster::sdf::point_segment_distance(p, chord)
-                    <= piece.reach(CHORD_SHARE * accuracy)
-            });
+        // The vertices strictly inside (s0, s1): `cum` ascends.
+        let lo = piece.cum.partition_point(|&c| c <= s0);
+        let hi = piece.cum.partition_point(|&c| c < s1).max(lo);
+        let within = piece.pts[lo..hi].iter().all(|&p| {
+            crate::raster::sdf::point_segment_distance(p, chord)
+                <= piece.reach(CHORD_SHARE * accuracy)
+        });
         let on_level_set = || {
             piece.holds(
                 (1..64).map(|k| a.lerp(b, k as f64 / 64.0)),

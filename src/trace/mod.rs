@@ -14,6 +14,7 @@ pub mod contour;
 pub mod corner;
 pub mod cover;
 pub mod fit;
+mod nearest;
 
 use crate::error::{Error, Result};
 use crate::raster::binary::SmoothLoop;

@@ -1,0 +1,133 @@
+//! The outline check's search for a polyline segment near a point
+//! ([`super::fit`]'s `Piece::holds`): each curve sample must lie within a
+//! distance of the outline, and most samples of a long span are far from
+//! most of its segments, so segments that cannot be close are skipped by
+//! their arc length.
+
+use kurbo::Point;
+
+/// Searches segments `from..=to` of the polyline `pts` (pixel
+/// coordinates; clamped to it; `cum` its cumulative arc lengths, px) for
+/// one within `near` px of `p`, stopping at the first: returns it, or
+/// `None` and the distance (px) of a segment within `far` (≥ `near`),
+/// infinity if none is. Segments that cannot come within `far` (once one
+/// is found: within `near`) are skipped by arc length: every point of
+/// segment `k ≥ j` is at most `cum[k + 1] − cum[j]` from vertex `j` along
+/// the polyline, so it is at least `|p − pts[j]| − (cum[k + 1] − cum[j])`
+/// from `p`.
+pub(super) fn nearest_segment(
+    pts: &[Point],
+    cum: &[f64],
+    p: Point,
+    from: usize,
+    to: usize,
+    near: f64,
+    far: f64,
+) -> (Option<usize>, f64) {
+    // Margin (px) for the rounding of the bound, far below any distance
+    // that matters.
+    const MARGIN: f64 = 1e-6;
+    let last = pts.len().saturating_sub(2);
+    let to = to.min(last);
+    let mut best = f64::INFINITY;
+    // Once a segment within `far` is known only `near` matters.
+    let mut bound = far;
+    let mut j = from;
+    while j <= to && j < pts.len().saturating_sub(1) {
+        let reach = (p - pts[j]).hypot() - bound - MARGIN;
+        if reach > 0.0 {
+            // Skip the segments ending less than `reach` further on
+            // (`cum` ascends).
+            let target = cum[j] + reach;
+            let skip = cum.get(j + 1..to + 2).map_or(0, |c| gallop(c, target));
+            if skip > 0 {
+                j += skip;
+                continue;
+            }
+        }
+        let d = crate::raster::sdf::point_segment_distance(p, kurbo::Line::new(pts[j], pts[j + 1]));
+        if d <= near {
+            return (Some(j), d);
+        }
+        if d <= far {
+            best = best.min(d);
+            bound = near;
+        }
+        j += 1;
+    }
+    (None, best)
+}
+
+/// The number of leading values of ascending `c` below `target`, found by
+/// doubling steps and then bisecting: the skips in [`nearest_segment`]
+/// are mostly a few segments, now and then thousands.
+fn gallop(c: &[f64], target: f64) -> usize {
+    let (mut lo, mut hi) = (0usize, 1usize);
+    while hi <= c.len() && c[hi - 1] < target {
+        lo = hi;
+        hi *= 2;
+    }
+    let hi = hi.min(c.len());
+    lo + c
+        .get(lo..hi)
+        .map_or(0, |c| c.partition_point(|&x| x < target))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use kurbo::Vec2;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(200))]
+
+        /// The galloping search agrees with a plain binary search.
+        #[test]
+        fn gallop_is_partition_point(mut c in prop::collection::vec(0.0f64..100.0, 0..60), t in -1.0f64..101.0) {
+            c.sort_by(|a, b| a.total_cmp(b));
+            prop_assert_eq!(gallop(&c, t), c.partition_point(|&x| x < t));
+        }
+
+        /// The segment search with skips by arc length answers as a scan
+        /// of every segment does: one within `near`, else one within `far`.
+        #[test]
+        fn nearest_segment_matches_brute_force(
+            steps in prop::collection::vec((-3.0f64..3.0, -3.0f64..3.0), 2..80),
+            px in -20.0f64..20.0,
+            py in -20.0f64..20.0,
+            near in 0.05f64..1.0,
+            extra in 0.0f64..1.0,
+            from_share in 0.0f64..1.0,
+        ) {
+            let mut pts = vec![Point::ORIGIN];
+            for (dx, dy) in steps {
+                let last = pts[pts.len() - 1];
+                pts.push(last + Vec2::new(dx, dy));
+            }
+            let n = pts.len();
+            let mut cum = vec![0.0];
+            for w in pts.windows(2) {
+                cum.push(cum[cum.len() - 1] + (w[1] - w[0]).hypot());
+            }
+            let far = near + extra;
+            let p = Point::new(px, py);
+            let from = ((n - 2) as f64 * from_share) as usize;
+            let dists: Vec<f64> = (from..n - 1)
+                .map(|j| crate::raster::sdf::point_segment_distance(p, kurbo::Line::new(pts[j], pts[j + 1])))
+                .collect();
+            let (found, best) = nearest_segment(&pts, &cum, p, from, n - 2, near, far);
+            match found {
+                Some(j) => {
+                    prop_assert!(j >= from && dists[j - from] <= near);
+                    prop_assert!(dists[..j - from].iter().all(|&d| d > near));
+                }
+                None => {
+                    prop_assert!(dists.iter().all(|&d| d > near));
+                    let any_far = dists.iter().any(|&d| d <= far);
+                    prop_assert_eq!(best <= far, any_far);
+                }
+            }
+        }
+    }
+}
