@@ -17,7 +17,7 @@
 //! 2003, §2.4). Consecutive cubics meet with G1 continuity: both take the
 //! outline's tangent at the join.
 
-use super::fit::{fit_span, is_line, line_cubic, polygon, Guide, Piece, MIN_SPAN_PX};
+use super::fit::{append_loop, corner_runs, line_cubic, longest_span, Guide, Piece, MIN_SPAN_PX};
 use crate::raster::corridor::Corridor;
 use kurbo::{BezPath, CubicBez, Point, Vec2};
 use rayon::prelude::*;
@@ -76,22 +76,7 @@ pub fn fit_outline(
     } else {
         // The runs between corners are independent: covered in parallel
         // (a large loop holds most of a drawing's work), gathered in order.
-        let runs: Vec<Vec<usize>> = (0..cs.len())
-            .map(|k| {
-                let a = cs[k];
-                let b = cs[(k + 1) % cs.len()];
-                let mut idx = vec![a];
-                let mut i = (a + 1) % n;
-                loop {
-                    idx.push(i);
-                    if i == b {
-                        break;
-                    }
-                    i = (i + 1) % n;
-                }
-                idx
-            })
-            .collect();
+        let runs = corner_runs(&cs, n);
         let covered: Vec<Vec<CubicBez>> = runs
             .par_iter()
             .map(|idx| {
@@ -102,21 +87,7 @@ pub fn fit_outline(
             .collect();
         covered.into_iter().flatten().collect()
     };
-    let mut first = true;
-    for c in cubics {
-        if first {
-            out.move_to(c.p0);
-            first = false;
-        }
-        if is_line(&c) {
-            out.line_to(c.p3);
-        } else {
-            out.curve_to(c.p1, c.p2, c.p3);
-        }
-    }
-    if !first {
-        out.close_path();
-    }
+    append_loop(&cubics, out);
 }
 
 /// Accumulated turning (radians) of the piece at each vertex, measured
@@ -182,42 +153,6 @@ fn cover_run(piece: &Piece, accuracy: f64, out: &mut Vec<CubicBez>) {
         } else {
             param(last.max(first_vertex)).max(start + min_span).min(1.0)
         };
-        if let Some(c) = fit_span(piece, start..hi, accuracy) {
-            out.push(c);
-            start = hi;
-            continue;
-        }
-        // Halve until one cubic fits.
-        let mut fail = hi;
-        let mut ok: Option<(f64, CubicBez)> = None;
-        let mut end = 0.5 * (start + fail);
-        while end - start >= min_span {
-            if let Some(c) = fit_span(piece, start..end, accuracy) {
-                ok = Some((end, c));
-                break;
-            }
-            fail = end;
-            end = 0.5 * (start + end);
-        }
-        let Some((mut good, mut cubic)) = ok else {
-            // Nothing fits even a short span: the polygon up to there.
-            let end = (start + min_span).min(1.0);
-            polygon(piece, start..end, out);
-            start = end;
-            continue;
-        };
-        // Bisect between the success and the failure above it.
-        while (fail - good) * total > (SEARCH_SHARE * (good - start) * total).max(0.5) {
-            let mid = 0.5 * (good + fail);
-            match fit_span(piece, start..mid, accuracy) {
-                Some(c) => {
-                    good = mid;
-                    cubic = c;
-                }
-                None => fail = mid,
-            }
-        }
-        out.push(cubic);
-        start = good;
+        start = longest_span(piece, start, hi, SEARCH_SHARE, accuracy, out);
     }
 }

@@ -420,6 +420,27 @@ pub fn fit_contour(pts: &[Point], sdf: &Sdf, accuracy: f64, out: &mut BezPath) {
     fit_loop(pts, &corners(pts), sdf, accuracy, out);
 }
 
+/// The vertex indices of each run of a closed loop of `n` vertices between
+/// consecutive corners `cs` (both corners included; the last run wraps
+/// around to the first corner).
+pub(super) fn corner_runs(cs: &[usize], n: usize) -> Vec<Vec<usize>> {
+    (0..cs.len())
+        .map(|k| {
+            let (a, b) = (cs[k], cs[(k + 1) % cs.len()]);
+            let mut idx = vec![a];
+            let mut i = (a + 1) % n;
+            loop {
+                idx.push(i);
+                if i == b {
+                    break;
+                }
+                i = (i + 1) % n;
+            }
+            idx
+        })
+        .collect()
+}
+
 /// The closed contour `pts` of `sdf` cut at `cs` into pieces, each fitted.
 fn fit_loop(pts: &[Point], cs: &[usize], sdf: &Sdf, accuracy: f64, out: &mut BezPath) {
     let n = pts.len();
@@ -437,43 +458,35 @@ fn fit_loop(pts: &[Point], cs: &[usize], sdf: &Sdf, accuracy: f64, out: &mut Bez
             pieces.push(Piece::new(p, Vec::new(), guide, false, false));
         }
     } else {
-        for k in 0..cs.len() {
-            let a = cs[k];
-            let b = cs[(k + 1) % cs.len()];
-            let mut idx = vec![a];
-            let mut i = (a + 1) % n;
-            loop {
-                idx.push(i);
-                if i == b {
-                    break;
-                }
-                i = (i + 1) % n;
-            }
+        for idx in corner_runs(cs, n) {
             let p = idx.iter().map(|&i| pts[i]).collect();
             pieces.push(Piece::new(p, Vec::new(), guide, true, true));
         }
     }
-    let mut first = true;
     let mut cubics = Vec::new();
     for piece in pieces.iter().flat_map(split_by_turning) {
         if piece.length() > 1e-9 {
             fit_piece(&piece, accuracy, &mut cubics);
         }
     }
+    append_loop(&cubics, out);
+}
+
+/// Appends the closed loop of consecutive `cubics` to `out` as one subpath
+/// (straight ones as lines); nothing for none.
+pub(super) fn append_loop(cubics: &[CubicBez], out: &mut BezPath) {
+    let Some(first) = cubics.first() else {
+        return;
+    };
+    out.move_to(first.p0);
     for c in cubics {
-        if first {
-            out.move_to(c.p0);
-            first = false;
-        }
-        if is_line(&c) {
+        if is_line(c) {
             out.line_to(c.p3);
         } else {
             out.curve_to(c.p1, c.p2, c.p3);
         }
     }
-    if !first {
-        out.close_path();
-    }
+    out.close_path();
 }
 
 pub(super) fn is_line(c: &CubicBez) -> bool {
@@ -577,49 +590,66 @@ fn fit_piece(piece: &Piece, accuracy: f64, out: &mut Vec<CubicBez>) {
         out.push(line_cubic(a, b));
         return;
     }
-    let total = piece.length();
-    let min_span = (MIN_SPAN_PX / total).min(1.0);
     let mut start = 0.0;
     while start < 1.0 {
-        if let Some(c) = fit_span(piece, start..1.0, accuracy) {
-            out.push(c);
+        // Down to an eighth of the span found (or half a pixel): a longer
+        // search buys little length and costs a fit per step.
+        start = longest_span(piece, start, 1.0, 0.125, accuracy, out);
+    }
+}
+
+/// Covers `piece` from `start` (a share of its length) with the longest
+/// span up to `hi` that one cubic fits, pushed to `out`, and returns where
+/// the span ends: the whole `start..hi` if it fits; else halved until one
+/// fits, then bisected between that success and the failure above it down
+/// to `share` of the span found (or half a pixel). When not even
+/// [`MIN_SPAN_PX`] fits, the polygon over that length (it lies on what is
+/// fitted).
+pub(super) fn longest_span(
+    piece: &Piece,
+    start: f64,
+    hi: f64,
+    share: f64,
+    accuracy: f64,
+    out: &mut Vec<CubicBez>,
+) -> f64 {
+    if let Some(c) = fit_span(piece, start..hi, accuracy) {
+        out.push(c);
+        return hi;
+    }
+    let total = piece.length();
+    let min_span = (MIN_SPAN_PX / total).min(1.0);
+    // Halve until one cubic fits.
+    let mut fail = hi;
+    let mut ok: Option<(f64, CubicBez)> = None;
+    let mut end = 0.5 * (start + fail);
+    while end - start >= min_span {
+        if let Some(c) = fit_span(piece, start..end, accuracy) {
+            ok = Some((end, c));
             break;
         }
-        // Halve until one cubic fits.
-        let mut fail = 1.0;
-        let mut ok: Option<(f64, CubicBez)> = None;
-        let mut end = 0.5 * (start + fail);
-        while end - start >= min_span {
-            if let Some(c) = fit_span(piece, start..end, accuracy) {
-                ok = Some((end, c));
-                break;
-            }
-            fail = end;
-            end = 0.5 * (start + end);
-        }
-        let Some((mut good, mut cubic)) = ok else {
-            // Nothing fits even a short span: the polygon up to there.
-            let end = (start + min_span).min(1.0);
-            polygon(piece, start..end, out);
-            start = end;
-            continue;
-        };
-        // Bisect between the success and the failure above it, down to an
-        // eighth of the span found (or half a pixel): a longer search buys
-        // little length and costs a fit per step.
-        while (fail - good) * total > (0.125 * (good - start) * total).max(0.5) {
-            let mid = 0.5 * (good + fail);
-            match fit_span(piece, start..mid, accuracy) {
-                Some(c) => {
-                    good = mid;
-                    cubic = c;
-                }
-                None => fail = mid,
-            }
-        }
-        out.push(cubic);
-        start = good;
+        fail = end;
+        end = 0.5 * (start + end);
     }
+    let Some((mut good, mut cubic)) = ok else {
+        // Nothing fits even a short span: the polygon up to there.
+        let end = (start + min_span).min(1.0);
+        polygon(piece, start..end, out);
+        return end;
+    };
+    // Bisect between the success and the failure above it.
+    while (fail - good) * total > (share * (good - start) * total).max(0.5) {
+        let mid = 0.5 * (good + fail);
+        match fit_span(piece, start..mid, accuracy) {
+            Some(c) => {
+                good = mid;
+                cubic = c;
+            }
+            None => fail = mid,
+        }
+    }
+    out.push(cubic);
+    good
 }
 
 /// One cubic for `range`: the fitted one if it passes [`fit_checked`], else
