@@ -4,6 +4,7 @@
 
 pub mod binary;
 pub mod corridor;
+pub mod cull;
 pub mod edt;
 pub mod input;
 pub mod plain;
