@@ -131,22 +131,32 @@ impl FillStyle {
             resolution.or(toml.resolution).unwrap_or(96),
             source,
         )?;
+        let flow = match toml.flow {
+            Some(DirectionToml::Vector(v)) => Flow::Fixed(v),
+            _ => Flow::Outline,
+        };
+        let defaults = EmParams::default();
         let params = EmParams {
             alpha: toml.alpha.unwrap_or(0.25) as f32,
             radius: (toml.patch.unwrap_or(9) / 2) as usize,
             levels: toml.levels.unwrap_or(3) as usize,
             iterations: toml.iterations.unwrap_or(4) as usize,
-            ..EmParams::default()
+            // The Shape Hint takes the tile's edge to be a line along its
+            // direction, so it frames an outline only where the field runs
+            // along it: under a fixed flow it would pull bands across the
+            // outline and tear the pattern there.
+            shape: match flow {
+                Flow::Outline => defaults.shape,
+                Flow::Fixed(_) => 0.0,
+            },
+            ..defaults
         };
         Ok(FillStyle {
             tile_path,
             tile,
             params,
             scale: toml.scale.unwrap_or(1.0),
-            flow: match toml.flow {
-                Some(DirectionToml::Vector(v)) => Flow::Fixed(v),
-                _ => Flow::Outline,
-            },
+            flow,
         })
     }
 
@@ -309,14 +319,6 @@ pub fn fill_sketch(opts: &FillOptions, sk: &Sketch) -> Result<FillOutput> {
         ));
         let params = EmParams {
             seed: crate::pattern::rng::hash(&[opts.seed, qi as u64]),
-            // The Shape Hint takes the tile's edge to be a line along its
-            // direction, so it frames an outline only where the field runs
-            // along it: under a fixed flow it would pull bands across the
-            // outline and tear the pattern there.
-            shape: match st.flow {
-                Flow::Outline => st.params.shape,
-                Flow::Fixed(_) => 0.0,
-            },
             ..st.params
         };
         let syn = em::synthesize_in(&st.tile, &region.direction, Some(&region.mask), &params);

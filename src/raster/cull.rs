@@ -57,9 +57,10 @@ pub fn cull_far_curves(path: &BezPath, window: Rect) -> BezPath {
                 last = p;
             }
             PathEl::QuadTo(a, b) => {
-                match keep(&QuadBez::new(last, a, b).raise()) {
+                let c = QuadBez::new(last, a, b).raise();
+                match keep(&c) {
                     Some(true) => out.quad_to(a, b),
-                    _ => halve(QuadBez::new(last, a, b).raise(), 0, &keep, &mut out),
+                    _ => halve(c, 0, &keep, &mut out),
                 }
                 last = b;
             }
