@@ -198,6 +198,21 @@ impl<'a> Piece<'a> {
         (l > 1e-9).then(|| t / l)
     }
 
+    /// For an SDF contour, whether the control points of `c` stay within a
+    /// pixel of the canvas: ink running off the canvas is closed along its
+    /// border (see [`clipped_value`]), where the contour is a straight run
+    /// and kurbo may put a handle many pixels past the canvas's edge with
+    /// the curve itself still on it.
+    fn keeps_handles_on_canvas(&self, c: &CubicBez) -> bool {
+        let Guide::Field(sdf) = self.guide else {
+            return true;
+        };
+        let (w, h) = (sdf.width() as f64, sdf.height() as f64);
+        [c.p1, c.p2]
+            .iter()
+            .all(|p| p.x >= -1.0 && p.y >= -1.0 && p.x <= w + 1.0 && p.y <= h + 1.0)
+    }
+
     /// Whether every point of `pts` lies within `limit` px of what the piece
     /// is fitted to, over arc lengths `s0..s1`: the SDF's zero level set, or
     /// the piece's own outline there (and a pixel either side).
@@ -721,7 +736,8 @@ fn fit_checked(piece: &Piece, range: Range<f64>, accuracy: f64) -> Option<CubicB
     let s0 = range.start * piece.length();
     let s1 = range.end * piece.length();
     let ok = piece.holds((1..64).map(|k| c.eval(k as f64 / 64.0)), s0, s1, accuracy)
-        && c.arclen(0.01) <= 1.5 * len + 0.5;
+        && c.arclen(0.01) <= 1.5 * len + 0.5
+        && piece.keeps_handles_on_canvas(&c);
     ok.then_some(c)
 }
 
