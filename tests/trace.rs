@@ -105,7 +105,7 @@ fn rendered_output_reproduces_the_bitmap() {
         let floor = match name.as_str() {
             "ornament-2mp.png" => 0.96,
             "thin-lines.png" => 0.955,
-            "thin-lines-binary.png" => 0.91,
+            "thin-lines-binary.png" => 0.92,
             n if n.starts_with("ornament-") => 0.975,
             _ => 0.99,
         };

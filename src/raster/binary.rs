@@ -24,7 +24,9 @@
 //! 4. **Vertex adjustment.** Each polygon vertex moves to the intersection
 //!    of the least-squares lines of its two edges' path vertices (their
 //!    interior ones: the ends chamfer the corner), kept within half a pixel
-//!    of where it was.
+//!    of where it was. Where the outline makes a U-turn over a vertex or a
+//!    short edge (the end of a line up to 3½ px wide), the turn becomes a
+//!    square cap at the farthest pixel edge ([`super::line_ends`]).
 //! 5. **Smoothing.** Each vertex becomes either a corner or a cubic from
 //!    the midpoint of its incoming edge to the midpoint of its outgoing
 //!    edge, with control points a fraction `α` of the way to the vertex; `α`
@@ -45,7 +47,7 @@
 //! inside of pixel centres taken from the curves (not from the bitmap), so
 //! the sign and the distance agree.
 
-use crate::raster::{Coverage, Grid, Sdf};
+use crate::raster::{line_ends, Coverage, Grid, Sdf};
 use crate::trace::contour;
 use kurbo::{CubicBez, ParamCurve, ParamCurveDeriv, Point, Vec2};
 use rayon::prelude::*;
@@ -126,8 +128,10 @@ fn smooth_loop(path: &[Point]) -> SmoothLoop {
     if poly.len() < 3 {
         return polyline_loop(path);
     }
-    let vertices = adjust_vertices(path, &poly);
-    smooth_polygon(&vertices)
+    let lines = edge_lines(path, &poly);
+    let vertices = adjust_vertices(path, &poly, &lines);
+    let (vertices, caps) = line_ends::square_line_ends(path, &poly, &lines, vertices);
+    smooth_polygon(&vertices, &caps)
 }
 
 /// A loop too small to smooth, kept as its polygon: every vertex a corner.
@@ -408,14 +412,13 @@ fn optimal_polygon(mut lon: impl FnMut(usize) -> usize, n: usize) -> Vec<usize> 
     best.unwrap_or_default()
 }
 
-/// Step 4: polygon vertices moved to where the least-squares lines of their
-/// two edges meet, within half a pixel of the path vertex.
-fn adjust_vertices(path: &[Point], poly: &[usize]) -> Vec<Point> {
+/// The least-squares line (centroid, unit direction from the edge's start
+/// to its end) of each polygon edge's path vertices, the chamfered ends
+/// left out: edge `e` runs from `poly[e]` to `poly[e + 1]`.
+pub(super) fn edge_lines(path: &[Point], poly: &[usize]) -> Vec<(Point, Vec2)> {
     let n = path.len();
     let k = poly.len();
-    // Least-squares line (centroid, unit direction) of each polygon edge's
-    // path vertices, ends included.
-    let lines: Vec<(Point, Vec2)> = (0..k)
+    (0..k)
         .map(|e| {
             let a = poly[e];
             let b = poly[(e + 1) % k];
@@ -436,7 +439,13 @@ fn adjust_vertices(path: &[Point], poly: &[usize]) -> Vec<Point> {
             let pts = (first..count - last).map(at);
             fit_line(pts, path[a], path[b])
         })
-        .collect();
+        .collect()
+}
+
+/// Step 4: polygon vertices moved to where the least-squares lines of their
+/// two edges ([`edge_lines`]) meet, within half a pixel of the path vertex.
+fn adjust_vertices(path: &[Point], poly: &[usize], lines: &[(Point, Vec2)]) -> Vec<Point> {
+    let k = poly.len();
     (0..k)
         .map(|e| {
             let v = path[poly[e]];
@@ -488,8 +497,9 @@ fn fit_line(pts: impl Iterator<Item = Point>, a: Point, b: Point) -> (Point, Vec
 }
 
 /// Step 5: corners and cubics through the edge midpoints, flattened, with
-/// the curve's tangent at every point.
-fn smooth_polygon(v: &[Point]) -> SmoothLoop {
+/// the curve's tangent at every point; vertices marked in `keep` (the
+/// square caps of thin-line ends) stay corners.
+fn smooth_polygon(v: &[Point], keep: &[bool]) -> SmoothLoop {
     let k = v.len();
     let mut out = SmoothLoop::default();
     let push = |out: &mut SmoothLoop, p: Point, t: Vec2, corner: bool| {
@@ -519,7 +529,7 @@ fn smooth_polygon(v: &[Point]) -> SmoothLoop {
         let m1 = a.midpoint(p);
         let m2 = p.midpoint(b);
         let alpha = corner_alpha(a, p, b);
-        if alpha >= ALPHA_MAX || is_line_end(a, p, b) {
+        if alpha >= ALPHA_MAX || is_line_end(a, p, b) || keep.get(j).copied().unwrap_or(false) {
             push(&mut out, m1, unit(p - a), false);
             push(&mut out, p, unit(b - p), true);
         } else {
@@ -729,7 +739,7 @@ fn smooth_tangents(l: &mut SmoothLoop) {
 }
 
 /// Longest edge (px) that can be the end of a thin line.
-const LINE_END_EDGE: f64 = 1.5;
+pub(super) const LINE_END_EDGE: f64 = 1.5;
 
 /// Whether polygon vertex `p` (between `a` and `b`) is a corner of a thin
 /// line's end: one of its edges at most [`LINE_END_EDGE`] long and the

@@ -1,0 +1,301 @@
+//! Thin-line ends of a binary bitmap's polygon, squared off (between steps 4
+//! and 5 of [`crate::raster::binary`]).
+//!
+//! The path through pixel-edge midpoints chamfers the end of a line one or
+//! two pixels wide down to a single tip vertex half a pixel out. A straight
+//! run may end at that tip (it passes within half a pixel of every vertex of
+//! the side), so the optimal polygon reaches the tip from both sides, or
+//! crosses the line's end on a slant, and smoothing then sharpens the line
+//! into a needle several pixels long: the last pixel or two of every thin
+//! line are lost, and the line narrows where the drawing keeps its width.
+//! potrace's paths through pixel corners do not have this tip (its straight
+//! runs cannot cut the end's corners, Selinger 2003, §2.2), and its polygon
+//! keeps such an end square.
+//!
+//! Here, where the outline makes a U-turn (the least-squares lines of the
+//! two sides run back along each other, within [`U_TURN`]) over a vertex or
+//! a short edge, the turn is replaced by a cap across the line: each side's
+//! line cut at the farthest point the path reaches in the line's direction
+//! (the tip lies on the pixel edge that ends the line). The cap's vertices
+//! stay corners in smoothing: the bitmap keeps a thin line's width to its
+//! last pixel, where potrace's corner measure would round the end off.
+
+use kurbo::{Point, Vec2};
+
+/// Sides whose directions are within this angle (radians) of exactly
+/// opposite make a U-turn: 12°. A line's two sides run parallel; a
+/// tapering stroke's tip (the scroll's leaves: 17–28° on the samples) is
+/// left a point.
+const U_TURN: f64 = std::f64::consts::PI / 15.0;
+
+/// Shortest side (px, and at least twice the cap's width) next to a cap:
+/// a line, not a notch of a pixel or two (a thin zigzag's apex, a tiny
+/// loop).
+const MIN_SIDE: f64 = 3.0;
+
+/// Widest line (px) whose end is squared off: a U-turn over an edge up to
+/// this long, or sides this far apart. potrace's corner measure (step 5)
+/// reads the corners of ends narrower than about 5 px as smooth and rounds
+/// them over half the line's length.
+const MAX_CAP: f64 = 3.5;
+
+/// Farthest (px) a cap vertex may move from the vertex it replaces: beyond
+/// it the sides' lines do not describe a line end (they are short or
+/// skewed), and the polygon is left alone.
+const MAX_MOVE: f64 = 1.5;
+
+/// One U-turn: the polygon vertices it replaces (`first` and `last`, equal
+/// for a single vertex) and the cap's two new vertices, on the incoming and
+/// on the outgoing side.
+struct Cap {
+    first: usize,
+    last: usize,
+    into: Point,
+    out_of: Point,
+}
+
+/// The polygon `vertices` (adjusted positions of path indices `poly`, edge
+/// `e` from vertex `e` to `e + 1` with least-squares line `lines[e]`) with
+/// every thin-line end replaced by a square cap (see the module docs), and
+/// per vertex whether it is a cap's corner (smoothing must keep it sharp).
+pub(super) fn square_line_ends(
+    path: &[Point],
+    poly: &[usize],
+    lines: &[(Point, Vec2)],
+    vertices: Vec<Point>,
+) -> (Vec<Point>, Vec<bool>) {
+    let k = vertices.len();
+    if k < 3 || poly.len() != k || lines.len() != k {
+        return (vertices, vec![false; k]);
+    }
+    let mut caps: Vec<Cap> = Vec::new();
+    let mut taken = vec![false; k];
+    for e in 0..k {
+        if taken[e] {
+            continue;
+        }
+        let prev = (e + k - 1) % k;
+        let next = (e + 1) % k;
+        // A U-turn at vertex e alone, or over the short edge e → e + 1.
+        let candidate = if opposite(lines[prev].1, lines[e].1) {
+            Some((e, prev, e))
+        } else if (vertices[next] - vertices[e]).hypot() <= MAX_CAP
+            && !taken[next]
+            && k >= 4
+            && opposite(lines[prev].1, lines[next].1)
+        {
+            Some((next, prev, next))
+        } else {
+            None
+        };
+        let Some((last, side_in, side_out)) = candidate else {
+            continue;
+        };
+        if let Some(cap) = cap(path, poly, lines, &vertices, e, last, side_in, side_out) {
+            taken[e] = true;
+            taken[last] = true;
+            caps.push(cap);
+        }
+    }
+    if caps.is_empty() {
+        return (vertices, vec![false; k]);
+    }
+    let mut replaced: Vec<Option<Vec<Point>>> = vec![None; k];
+    for c in caps {
+        if c.first == c.last {
+            replaced[c.first] = Some(vec![c.into, c.out_of]);
+        } else {
+            replaced[c.first] = Some(vec![c.into]);
+            replaced[c.last] = Some(vec![c.out_of]);
+        }
+    }
+    let mut out = Vec::with_capacity(k + 4);
+    let mut corner = Vec::with_capacity(k + 4);
+    for (v, r) in vertices.into_iter().zip(replaced) {
+        match r {
+            Some(cap) => {
+                corner.extend(cap.iter().map(|_| true));
+                out.extend(cap);
+            }
+            None => {
+                out.push(v);
+                corner.push(false);
+            }
+        }
+    }
+    (out, corner)
+}
+
+/// Whether unit directions `a` and `b` are within [`U_TURN`] of opposite.
+fn opposite(a: Vec2, b: Vec2) -> bool {
+    a.dot(b) < -U_TURN.cos()
+}
+
+/// The square cap of the U-turn over polygon vertices `first..=last`
+/// between side lines `lines[side_in]` and `lines[side_out]`, or None when
+/// the cut would move a vertex more than [`MAX_MOVE`] or the cap be wider
+/// than [`MAX_CAP`].
+#[allow(clippy::too_many_arguments)]
+fn cap(
+    path: &[Point],
+    poly: &[usize],
+    lines: &[(Point, Vec2)],
+    vertices: &[Point],
+    first: usize,
+    last: usize,
+    side_in: usize,
+    side_out: usize,
+) -> Option<Cap> {
+    let n = path.len();
+    let (c0, d0) = lines[side_in];
+    let (c1, d1) = lines[side_out];
+    // The line's direction towards its end: the mean of the side coming in
+    // and the reverse of the side going out.
+    let axis = d0 - d1;
+    let len = axis.hypot();
+    if len < 1e-9 {
+        return None;
+    }
+    let axis = axis / len;
+    // The end: the farthest the path reaches along the axis around the
+    // turn (its tip vertex, on the pixel edge that ends the line), a couple
+    // of path vertices either side included in case the polygon vertex is
+    // not the tip itself.
+    let (a, b) = (poly[first], poly[last]);
+    let span = (b + n - a) % n;
+    let reach = (0..=span + 4)
+        .map(|s| path[(a + n - 2 + s) % n].to_vec2().dot(axis))
+        .fold(f64::NEG_INFINITY, f64::max);
+    // Each side's line cut where it reaches the end.
+    let cut = |c: Point, d: Vec2| -> Option<Point> {
+        let along = d.dot(axis);
+        (along.abs() > 0.5).then(|| c + d * ((reach - c.to_vec2().dot(axis)) / along))
+    };
+    let into = cut(c0, d0)?;
+    let out_of = cut(c1, d1)?;
+    let moved = (into - vertices[first])
+        .hypot()
+        .max((out_of - vertices[last]).hypot());
+    let width = (out_of - into).hypot();
+    let k = vertices.len();
+    let side = (vertices[first] - vertices[side_in])
+        .hypot()
+        .min((vertices[(last + 1) % k] - vertices[last]).hypot());
+    if side < MIN_SIDE.max(2.0 * width) {
+        return None;
+    }
+    (moved <= MAX_MOVE && width <= MAX_CAP && into.is_finite() && out_of.is_finite()).then_some(
+        Cap {
+            first,
+            last,
+            into,
+            out_of,
+        },
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::raster::binary::smooth_loops;
+    use crate::raster::{Coverage, Grid};
+    use kurbo::{Point, Rect};
+
+    /// Distance (px) from `p` to the boundary of `r`.
+    fn to_boundary(r: Rect, p: Point) -> f64 {
+        let dx = (p.x - r.x0).abs().min((p.x - r.x1).abs());
+        let dy = (p.y - r.y0).abs().min((p.y - r.y1).abs());
+        if (r.x0..=r.x1).contains(&p.x) && (r.y0..=r.y1).contains(&p.y) {
+            dx.min(dy)
+        } else {
+            let cx = p.x.clamp(r.x0, r.x1);
+            let cy = p.y.clamp(r.y0, r.y1);
+            (p.x - cx).hypot(p.y - cy)
+        }
+    }
+
+    #[test]
+    fn lines_one_to_three_pixels_wide_keep_square_ends() {
+        for w in 1..=3usize {
+            let r = Rect::new(5.0, 5.0, 5.0 + w as f64, 35.0);
+            let cov: Coverage = Grid::from_fn(12, 40, |x, y| {
+                let inside = (5..5 + w).contains(&x) && (5..35).contains(&y);
+                if inside {
+                    1.0
+                } else {
+                    0.0
+                }
+            });
+            let loops = smooth_loops(&cov);
+            assert_eq!(loops.len(), 1, "width {w}");
+            let l = &loops[0];
+            // The outline is the rectangle the pixels fill: full length and
+            // width to the last pixel (before, the ends narrowed to a needle
+            // several pixels long, or were rounded off).
+            let worst = l
+                .points
+                .iter()
+                .map(|&p| to_boundary(r, p))
+                .fold(0.0, f64::max);
+            assert!(worst < 1e-6, "width {w}: {worst} px off the rectangle");
+            for corner in [(r.x0, r.y0), (r.x1, r.y0), (r.x1, r.y1), (r.x0, r.y1)] {
+                let c = Point::new(corner.0, corner.1);
+                let i = l.points.iter().position(|&p| (p - c).hypot() < 1e-6);
+                let i = i.unwrap_or_else(|| panic!("width {w}: no vertex at {c:?}"));
+                assert!(l.corners.contains(&i), "width {w}: {c:?} is not a corner");
+            }
+        }
+    }
+
+    /// A diagonal line 1.5 px wide, its pixels those whose centre lies
+    /// within the stroke: both ends keep within a pixel of the drawn end,
+    /// across the stroke as well as along it.
+    #[test]
+    fn a_diagonal_line_reaches_its_ends() {
+        let (a, b) = (Point::new(8.3, 31.7), Point::new(33.6, 6.2));
+        let dir = (b - a) / (b - a).hypot();
+        let half = 0.75;
+        let cov: Coverage = Grid::from_fn(42, 40, |x, y| {
+            let p = Point::new(x as f64 + 0.5, y as f64 + 0.5) - a;
+            let along = p.dot(dir);
+            let across = p.cross(dir).abs();
+            if (0.0..=(b - a).hypot()).contains(&along) && across <= half {
+                1.0
+            } else {
+                0.0
+            }
+        });
+        let loops = smooth_loops(&cov);
+        assert_eq!(loops.len(), 1);
+        let along: Vec<f64> = loops[0].points.iter().map(|&p| (p - a).dot(dir)).collect();
+        let lo = along.iter().cloned().fold(f64::INFINITY, f64::min);
+        let hi = along.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+        let len = (b - a).hypot();
+        assert!(lo < 0.6 && lo > -1.0, "start {lo:.2} px from the drawn end");
+        assert!(
+            hi > len - 0.6 && hi < len + 1.0,
+            "end {:.2} px short",
+            len - hi
+        );
+        // Near each end the outline is still about as wide as the stroke:
+        // where the cross-section at `s` px along meets the outline.
+        let pts = &loops[0].points;
+        let width_at = |s: f64| {
+            let mut across = Vec::new();
+            for i in 0..pts.len() {
+                let (p, q) = ((pts[i] - a), (pts[(i + 1) % pts.len()] - a));
+                let (sp, sq) = (p.dot(dir) - s, q.dot(dir) - s);
+                if sp * sq <= 0.0 && sp != sq {
+                    let t = sp / (sp - sq);
+                    across.push(p.lerp(q, t).cross(dir));
+                }
+            }
+            let max = across.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+            let min = across.iter().cloned().fold(f64::INFINITY, f64::min);
+            max - min
+        };
+        for s in [1.5, len - 1.5] {
+            let w = width_at(s);
+            assert!(w > 0.8, "{w:.2} px wide at {s:.1} px along");
+        }
+    }
+}
