@@ -21,6 +21,7 @@ use kurbo::{
     Affine, BezPath, CubicBez, CurveFitSample, ParamCurve, ParamCurveArclen, ParamCurveFit, Point,
     Vec2,
 };
+use std::cell::Cell;
 use std::ops::Range;
 
 /// Distance (px) from a corner within which tangents come from the polygon
@@ -92,6 +93,10 @@ pub(super) struct Piece<'a> {
     /// segments (relative to `origin`), for [`Guide::Outline`]; empty for
     /// SDF contours, which keep kurbo's quadrature.
     moments: Vec<[f64; 3]>,
+    /// The segment [`Self::locate`] found last: the fitter samples a span
+    /// in ascending arc length, so the next one is usually this or the one
+    /// after (a hint only, the answer does not depend on it).
+    hint: Cell<usize>,
 }
 
 impl<'a> Piece<'a> {
@@ -135,13 +140,14 @@ impl<'a> Piece<'a> {
             corner_end,
             origin,
             moments,
+            hint: Cell::new(0),
         }
     }
 
     /// How far (px) from the piece's own polyline a curve within
     /// `accuracy` of what it is fitted to may lie: `accuracy`, plus the
     /// corridor's half-width when a corridor decides.
-    fn reach(&self, accuracy: f64) -> f64 {
+    pub(super) fn reach(&self, accuracy: f64) -> f64 {
         match self.guide {
             Guide::Outline(Some(_)) => accuracy + Corridor::HALF_WIDTH,
             _ => accuracy,
@@ -216,7 +222,13 @@ impl<'a> Piece<'a> {
     /// Whether every point of `pts` lies within `limit` px of what the piece
     /// is fitted to, over arc lengths `s0..s1`: the SDF's zero level set, or
     /// the piece's own outline there (and a pixel either side).
-    fn holds(&self, pts: impl Iterator<Item = Point>, s0: f64, s1: f64, limit: f64) -> bool {
+    pub(super) fn holds(
+        &self,
+        pts: impl Iterator<Item = Point>,
+        s0: f64,
+        s1: f64,
+        limit: f64,
+    ) -> bool {
         match self.guide {
             Guide::Field(sdf) => {
                 let limit = limit + CHECK_SLACK;
@@ -268,14 +280,26 @@ impl<'a> Piece<'a> {
         }
     }
 
-    /// Segment index and position at arc length `s`.
+    /// Segment index and position at arc length `s` (clamped to the
+    /// piece): the segment `i` with `cum[i] ≤ s < cum[i + 1]` (the last one
+    /// at the end), tried first at and after the last one found, then by
+    /// binary search.
     fn locate(&self, s: f64) -> (usize, Point) {
         let n = self.pts.len();
         let s = s.clamp(0.0, self.length());
-        let i = match self.cum.binary_search_by(|c| c.total_cmp(&s)) {
-            Ok(i) => i.min(n - 2),
-            Err(i) => i.saturating_sub(1).min(n - 2),
+        let within = |i: usize| self.cum[i] <= s && (s < self.cum[i + 1] || i + 2 == n);
+        let h = self.hint.get().min(n - 2);
+        let i = if within(h) {
+            h
+        } else if h + 3 <= n && within(h + 1) {
+            h + 1
+        } else {
+            self.cum
+                .partition_point(|&c| c <= s)
+                .saturating_sub(1)
+                .min(n - 2)
         };
+        self.hint.set(i);
         let seg = self.cum[i + 1] - self.cum[i];
         let t = if seg > 0.0 {
             (s - self.cum[i]) / seg
@@ -396,6 +420,41 @@ impl ParamCurveFit for Piece<'_> {
 }
 
 impl Piece<'_> {
+    /// Position (px) and unit tangent at `t` (a share of the length) for
+    /// each of [`FIT_SAMPLES`] points evenly spread over `range`, where
+    /// kurbo's fitter samples them.
+    pub(super) fn samples(&self, range: Range<f64>) -> [(Point, Vec2); FIT_SAMPLES] {
+        let step = (range.end - range.start) / (FIT_SAMPLES - 1) as f64;
+        let mut out = [(Point::ORIGIN, Vec2::ZERO); FIT_SAMPLES];
+        for (i, o) in out.iter_mut().enumerate() {
+            let s = self.sample_pt_tangent(range.start + i as f64 * step, 1.0);
+            *o = (s.p + self.origin, s.tangent);
+        }
+        out
+    }
+
+    /// Position (px) and unit tangent at the start (`at_start`) or end of
+    /// a span at `t`, the tangents the span's cubic takes there.
+    pub(super) fn end_sample(&self, t: f64, at_start: bool) -> (Point, Vec2) {
+        let s = self.sample_pt_tangent(t, if at_start { 1.0 } else { -1.0 });
+        let l = s.tangent.hypot();
+        let tan = if l > 1e-12 { s.tangent / l } else { s.tangent };
+        (s.p + self.origin, tan)
+    }
+
+    /// Signed area `∫ y dx` and moments `∫ x y dx`, `½ ∫ y² dx` (px², px³)
+    /// of the closed loop made of the outline over `range` and the chord
+    /// back from `p3` to `p0`, about `p0` (the integrals of a closed loop
+    /// shift with the origin by the area times the shift).
+    pub(super) fn span_moments(&self, range: Range<f64>, p0: Point, p3: Point) -> [f64; 3] {
+        let o = self.origin;
+        let (a, x, y) = self.moment_integrals(range);
+        let c = segment_moments(p0 - o, p3 - o);
+        let (a, x, y) = (a - c[0], x - c[1], y - c[2]);
+        let q = p0 - o;
+        [a, x - q.x * a, 0.5 * y - q.y * a]
+    }
+
     /// kurbo's default moment integrals (16-point Gauss–Legendre on the
     /// derivative), kept for SDF contours so their output does not change.
     fn quadrature_moments(&self, range: Range<f64>) -> (f64, f64, f64) {
@@ -722,15 +781,21 @@ pub(super) fn polygon(piece: &Piece, range: Range<f64>, out: &mut Vec<CubicBez>)
 /// further but kept as a polygon.
 pub(super) const MIN_SPAN_PX: f64 = 1.5;
 
-/// One cubic for `range` of the piece, if kurbo finds one within `accuracy`
-/// that also stays within `accuracy` + [`CHECK_SLACK`] of the SDF's zero
-/// level at 16 points and does not loop away (arc length at most 1.5× the
-/// source's).
+/// One cubic for `range` of the piece that passes the piece's checks: for
+/// an exact outline the direct fit ([`super::direct`]); for an SDF contour
+/// kurbo's fitter, with the curve also within `accuracy` + [`CHECK_SLACK`]
+/// of the SDF's zero level at 63 points. Either way the curve may not loop
+/// away (arc length at most 1.5× the source's) and the range must not be
+/// "spicy" (see [`is_spicy`]).
 fn fit_checked(piece: &Piece, range: Range<f64>, accuracy: f64) -> Option<CubicBez> {
-    let len = piece.length() * (range.end - range.start);
-    if is_spicy(piece, range.clone()) {
+    let samples = piece.samples(range.clone());
+    if is_spicy(&samples) {
         return None;
     }
+    if let Guide::Outline(_) = piece.guide {
+        return super::direct::fit_span_direct(piece, range, &samples, accuracy);
+    }
+    let len = piece.length() * (range.end - range.start);
     let (c, _) = kurbo::fit_to_cubic(piece, range.clone(), piece.reach(accuracy))?;
     let c = Affine::translate(piece.origin) * c;
     let s0 = range.start * piece.length();
@@ -741,26 +806,19 @@ fn fit_checked(piece: &Piece, range: Range<f64>, accuracy: f64) -> Option<CubicB
     ok.then_some(c)
 }
 
+/// Number of samples (ends included) a range is checked at: kurbo's error
+/// measure samples 20 interior points, so does [`super::direct`].
+pub(super) const FIT_SAMPLES: usize = 22;
+
 /// True when kurbo would judge the range "spicy" (tangents of neighbouring
 /// error samples more than about 11° apart) and fall back to measuring
 /// error by arc length at 1e-9 accuracy, which is very slow; such ranges
-/// are split first.
-fn is_spicy(piece: &Piece, range: Range<f64>) -> bool {
-    const N: usize = 22;
-    let step = (range.end - range.start) / (N - 1) as f64;
-    let mut last: Option<Vec2> = None;
-    for i in 0..N {
-        let t = piece
-            .sample_pt_tangent(range.start + i as f64 * step, 1.0)
-            .tangent;
-        if let Some(l) = last {
-            if t.cross(l).abs() > 0.2 * t.dot(l).abs() {
-                return true;
-            }
-        }
-        last = Some(t);
-    }
-    false
+/// are split first. The outline path keeps the same limit on how sharply
+/// one cubic's source may bend between samples.
+fn is_spicy(samples: &[(Point, Vec2); FIT_SAMPLES]) -> bool {
+    samples
+        .windows(2)
+        .any(|w| w[1].1.cross(w[0].1).abs() > 0.2 * w[1].1.dot(w[0].1).abs())
 }
 
 #[cfg(test)]

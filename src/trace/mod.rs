@@ -13,6 +13,7 @@
 pub mod contour;
 pub mod corner;
 pub mod cover;
+mod direct;
 pub mod fit;
 mod nearest;
 
