@@ -17,7 +17,8 @@
 //! 2003, §2.4). Consecutive cubics meet with G1 continuity: both take the
 //! outline's tangent at the join.
 
-use super::fit::{append_loop, corner_runs, line_cubic, longest_span, Guide, Piece, MIN_SPAN_PX};
+use super::fit::{corner_runs, Guide, Piece};
+use super::span::{append_loop, line_cubic, longest_span, MIN_SPAN_PX};
 use crate::raster::corridor::Corridor;
 use kurbo::{BezPath, CubicBez, Point, Vec2};
 use rayon::prelude::*;

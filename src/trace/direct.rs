@@ -19,8 +19,9 @@
 //! outline (`Piece::holds`), which is all the fitter is held to, so no
 //! separate error measure along normals is needed.
 
-use super::fit::{Piece, FIT_SAMPLES};
+use super::fit::Piece;
 use super::nearest::nearest_segment;
+use super::span::FIT_SAMPLES;
 use kurbo::common::{factor_quartic_inner, solve_cubic, solve_quadratic};
 use kurbo::{CubicBez, ParamCurve, Point, Vec2};
 

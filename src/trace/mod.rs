@@ -16,6 +16,7 @@ pub mod cover;
 mod direct;
 pub mod fit;
 mod nearest;
+mod span;
 
 use crate::error::{Error, Result};
 use crate::raster::binary::SmoothLoop;
