@@ -36,7 +36,7 @@ const TURN_STEP: f64 = 3.0;
 /// The search for the end of a span stops when the bracket between the
 /// longest span that fits and the shortest that does not is below this
 /// share of the span (or half a pixel).
-const SEARCH_SHARE: f64 = 0.0625;
+const SEARCH_SHARE: f64 = 0.125;
 
 /// Fits a closed outline (pixel coordinates) with cubic Béziers within
 /// `accuracy` px of it, appending a closed subpath to `out`: `tangents` are
