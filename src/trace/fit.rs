@@ -14,7 +14,7 @@
 //! the curves meet there at an angle, so sharp corners stay sharp.
 
 use super::corner::corners;
-use super::nearest::nearest_segment;
+use super::nearest::{gallop_le as gallop, nearest_segment};
 use super::span::{append_loop, line_cubic, longest_span, FIT_SAMPLES};
 use crate::raster::corridor::Corridor;
 use crate::raster::Sdf;
@@ -289,8 +289,10 @@ impl<'a> Piece<'a> {
         let h = self.hint.get().min(n - 2);
         let i = if within(h) {
             h
-        } else if h + 3 <= n && within(h + 1) {
-            h + 1
+        } else if self.cum[h] <= s {
+            // Ahead of the hint: gallop forwards (samples step along).
+            let ahead = self.cum.get(h + 1..).unwrap_or(&[]);
+            (h + gallop(ahead, s)).min(n - 2)
         } else {
             self.cum
                 .partition_point(|&c| c <= s)
