@@ -4,10 +4,11 @@
 //! Each run between two corners (or a whole loop without corners) is one
 //! fitting source ([`Piece`], tangents given by the outline, exact area and
 //! moment integrals of the polyline). From the start of what is left, the
-//! longest span that one cubic fits is searched for (kurbo's single-cubic
-//! fitter `fit_to_cubic`, which matches area and first moments under the
-//! end tangents, then every curve checked against the outline itself, see
-//! [`fit_span`]); the span is only capped by how much the outline turns
+//! longest span that one cubic fits is searched for (the direct fitter of
+//! [`super::direct`], which matches area and first moment under the end
+//! tangents and judges each candidate by the outline itself both ways; see
+//! [`super::span::fit_span`]), halving and then bisecting down to an
+//! eighth of the span; the span is only capped by how much the outline turns
 //! within it ([`MAX_SPAN_TURN`]), not cut into fixed pieces beforehand, so
 //! a run costs no more cubics than its shape needs. When fitting is
 //! monotone in the span (a sub-span of a span that fits, fits), extending
@@ -17,7 +18,8 @@
 //! 2003, §2.4). Consecutive cubics meet with G1 continuity: both take the
 //! outline's tangent at the join.
 
-use super::fit::{append_loop, corner_runs, line_cubic, longest_span, Guide, Piece, MIN_SPAN_PX};
+use super::fit::{corner_runs, Guide, Piece};
+use super::span::{append_loop, line_cubic, longest_span, MIN_SPAN_PX};
 use crate::raster::corridor::Corridor;
 use kurbo::{BezPath, CubicBez, Point, Vec2};
 use rayon::prelude::*;
@@ -35,7 +37,7 @@ const TURN_STEP: f64 = 3.0;
 /// The search for the end of a span stops when the bracket between the
 /// longest span that fits and the shortest that does not is below this
 /// share of the span (or half a pixel).
-const SEARCH_SHARE: f64 = 0.0625;
+const SEARCH_SHARE: f64 = 0.125;
 
 /// Fits a closed outline (pixel coordinates) with cubic Béziers within
 /// `accuracy` px of it, appending a closed subpath to `out`: `tangents` are

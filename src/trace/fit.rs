@@ -6,21 +6,21 @@
 //! tangents perpendicular to the SDF gradient, which is smooth where the
 //! outline is, so pieces join with G1 continuity. `fit_to_bezpath_opt`
 //! then finds the fewest cubics within the tolerance. An outline known
-//! exactly (a bitmap's smoothed or sub-pixel outline) is fitted with the
-//! same [`Piece`] source by [`super::cover`], with its own tangents and
-//! corners, exact moment integrals, and each curve checked against the
-//! outline itself (and a binary bitmap's corridor) instead of an SDF. Corners are the
+//! exactly (a bitmap's smoothed or sub-pixel outline) is a [`Piece`] too,
+//! covered by [`super::cover`] with its own tangents and corners, exact
+//! moment integrals, and fitted by [`super::direct`] (no kurbo), each curve
+//! checked against the outline itself (and a binary bitmap's corridor)
+//! instead of an SDF. The span search both share is [`super::span`]. Corners are the
 //! vertices where the outline turns sharply within a pixel-scale window;
 //! the curves meet there at an angle, so sharp corners stay sharp.
 
 use super::corner::corners;
-use super::nearest::nearest_segment;
+use super::nearest::{gallop_le as gallop, nearest_segment};
+use super::span::{append_loop, line_cubic, longest_span, FIT_SAMPLES};
 use crate::raster::corridor::Corridor;
 use crate::raster::Sdf;
-use kurbo::{
-    Affine, BezPath, CubicBez, CurveFitSample, ParamCurve, ParamCurveArclen, ParamCurveFit, Point,
-    Vec2,
-};
+use kurbo::{BezPath, CubicBez, CurveFitSample, ParamCurveFit, Point, Vec2};
+use std::cell::Cell;
 use std::ops::Range;
 
 /// Distance (px) from a corner within which tangents come from the polygon
@@ -77,21 +77,25 @@ fn clipped_gradient(sdf: &Sdf, p: Point) -> Vec2 {
 /// One piece of a closed contour between corners (or the whole contour),
 /// parameterized by normalized arc length.
 pub(super) struct Piece<'a> {
-    pts: Vec<Point>,
+    pub(super) pts: Vec<Point>,
     /// Unit tangent at each vertex ([`Guide::Outline`] only, else empty).
     tangents: Vec<Vec2>,
     /// Cumulative arc length at each vertex.
-    cum: Vec<f64>,
-    guide: Guide<'a>,
+    pub(super) cum: Vec<f64>,
+    pub(super) guide: Guide<'a>,
     corner_start: bool,
     corner_end: bool,
     /// The fitter sees coordinates relative to this point: kurbo's moment
     /// integrals lose precision far from the origin.
-    origin: Vec2,
+    pub(super) origin: Vec2,
     /// Prefix sums of the exact area and moment integrals of the polyline's
     /// segments (relative to `origin`), for [`Guide::Outline`]; empty for
     /// SDF contours, which keep kurbo's quadrature.
     moments: Vec<[f64; 3]>,
+    /// The segment [`Self::locate`] found last: the fitter samples a span
+    /// in ascending arc length, so the next one is usually this or the one
+    /// after (a hint only, the answer does not depend on it).
+    hint: Cell<usize>,
 }
 
 impl<'a> Piece<'a> {
@@ -135,13 +139,14 @@ impl<'a> Piece<'a> {
             corner_end,
             origin,
             moments,
+            hint: Cell::new(0),
         }
     }
 
     /// How far (px) from the piece's own polyline a curve within
     /// `accuracy` of what it is fitted to may lie: `accuracy`, plus the
     /// corridor's half-width when a corridor decides.
-    fn reach(&self, accuracy: f64) -> f64 {
+    pub(super) fn reach(&self, accuracy: f64) -> f64 {
         match self.guide {
             Guide::Outline(Some(_)) => accuracy + Corridor::HALF_WIDTH,
             _ => accuracy,
@@ -203,7 +208,7 @@ impl<'a> Piece<'a> {
     /// border (see [`clipped_value`]), where the contour is a straight run
     /// and kurbo may put a handle many pixels past the canvas's edge with
     /// the curve itself still on it.
-    fn keeps_handles_on_canvas(&self, c: &CubicBez) -> bool {
+    pub(super) fn keeps_handles_on_canvas(&self, c: &CubicBez) -> bool {
         let Guide::Field(sdf) = self.guide else {
             return true;
         };
@@ -216,7 +221,13 @@ impl<'a> Piece<'a> {
     /// Whether every point of `pts` lies within `limit` px of what the piece
     /// is fitted to, over arc lengths `s0..s1`: the SDF's zero level set, or
     /// the piece's own outline there (and a pixel either side).
-    fn holds(&self, pts: impl Iterator<Item = Point>, s0: f64, s1: f64, limit: f64) -> bool {
+    pub(super) fn holds(
+        &self,
+        pts: impl Iterator<Item = Point>,
+        s0: f64,
+        s1: f64,
+        limit: f64,
+    ) -> bool {
         match self.guide {
             Guide::Field(sdf) => {
                 let limit = limit + CHECK_SLACK;
@@ -268,14 +279,28 @@ impl<'a> Piece<'a> {
         }
     }
 
-    /// Segment index and position at arc length `s`.
-    fn locate(&self, s: f64) -> (usize, Point) {
+    /// Segment index and position at arc length `s` (clamped to the
+    /// piece): the segment `i` with `cum[i] ≤ s < cum[i + 1]` (the last one
+    /// at the end), tried first at and after the last one found, then by
+    /// binary search.
+    pub(super) fn locate(&self, s: f64) -> (usize, Point) {
         let n = self.pts.len();
         let s = s.clamp(0.0, self.length());
-        let i = match self.cum.binary_search_by(|c| c.total_cmp(&s)) {
-            Ok(i) => i.min(n - 2),
-            Err(i) => i.saturating_sub(1).min(n - 2),
+        let within = |i: usize| self.cum[i] <= s && (s < self.cum[i + 1] || i + 2 == n);
+        let h = self.hint.get().min(n - 2);
+        let i = if within(h) {
+            h
+        } else if self.cum[h] <= s {
+            // Ahead of the hint: gallop forwards (samples step along).
+            let ahead = self.cum.get(h + 1..).unwrap_or(&[]);
+            (h + gallop(ahead, s)).min(n - 2)
+        } else {
+            self.cum
+                .partition_point(|&c| c <= s)
+                .saturating_sub(1)
+                .min(n - 2)
         };
+        self.hint.set(i);
         let seg = self.cum[i + 1] - self.cum[i];
         let t = if seg > 0.0 {
             (s - self.cum[i]) / seg
@@ -396,6 +421,41 @@ impl ParamCurveFit for Piece<'_> {
 }
 
 impl Piece<'_> {
+    /// Position (px) and unit tangent at `t` (a share of the length) for
+    /// each of [`FIT_SAMPLES`] points evenly spread over `range`, where
+    /// kurbo's fitter samples them.
+    pub(super) fn samples(&self, range: Range<f64>) -> [(Point, Vec2); FIT_SAMPLES] {
+        let step = (range.end - range.start) / (FIT_SAMPLES - 1) as f64;
+        let mut out = [(Point::ORIGIN, Vec2::ZERO); FIT_SAMPLES];
+        for (i, o) in out.iter_mut().enumerate() {
+            let s = self.sample_pt_tangent(range.start + i as f64 * step, 1.0);
+            *o = (s.p + self.origin, s.tangent);
+        }
+        out
+    }
+
+    /// Position (px) and unit tangent at the start (`at_start`) or end of
+    /// a span at `t`, the tangents the span's cubic takes there.
+    pub(super) fn end_sample(&self, t: f64, at_start: bool) -> (Point, Vec2) {
+        let s = self.sample_pt_tangent(t, if at_start { 1.0 } else { -1.0 });
+        let l = s.tangent.hypot();
+        let tan = if l > 1e-12 { s.tangent / l } else { s.tangent };
+        (s.p + self.origin, tan)
+    }
+
+    /// Signed area `∫ y dx` and moments `∫ x y dx`, `½ ∫ y² dx` (px², px³)
+    /// of the closed loop made of the outline over `range` and the chord
+    /// back from `p3` to `p0`, about `p0` (the integrals of a closed loop
+    /// shift with the origin by the area times the shift).
+    pub(super) fn span_moments(&self, range: Range<f64>, p0: Point, p3: Point) -> [f64; 3] {
+        let o = self.origin;
+        let (a, x, y) = self.moment_integrals(range);
+        let c = segment_moments(p0 - o, p3 - o);
+        let (a, x, y) = (a - c[0], x - c[1], y - c[2]);
+        let q = p0 - o;
+        [a, x - q.x * a, 0.5 * y - q.y * a]
+    }
+
     /// kurbo's default moment integrals (16-point Gauss–Legendre on the
     /// derivative), kept for SDF contours so their output does not change.
     fn quadrature_moments(&self, range: Range<f64>) -> (f64, f64, f64) {
@@ -485,31 +545,6 @@ fn fit_loop(pts: &[Point], cs: &[usize], sdf: &Sdf, accuracy: f64, out: &mut Bez
         }
     }
     append_loop(&cubics, out);
-}
-
-/// Appends the closed loop of consecutive `cubics` to `out` as one subpath
-/// (straight ones as lines); nothing for none.
-pub(super) fn append_loop(cubics: &[CubicBez], out: &mut BezPath) {
-    let Some(first) = cubics.first() else {
-        return;
-    };
-    out.move_to(first.p0);
-    for c in cubics {
-        if is_line(c) {
-            out.line_to(c.p3);
-        } else {
-            out.curve_to(c.p1, c.p2, c.p3);
-        }
-    }
-    out.close_path();
-}
-
-pub(super) fn is_line(c: &CubicBez) -> bool {
-    c.p1 == c.p0.lerp(c.p3, 1.0 / 3.0) && c.p2 == c.p0.lerp(c.p3, 2.0 / 3.0)
-}
-
-pub(super) fn line_cubic(a: Point, b: Point) -> CubicBez {
-    CubicBez::new(a, a.lerp(b, 1.0 / 3.0), a.lerp(b, 2.0 / 3.0), b)
 }
 
 /// Largest turning (radians) of one piece handed to the fitter: a quarter
@@ -613,162 +648,12 @@ fn fit_piece(piece: &Piece, accuracy: f64, out: &mut Vec<CubicBez>) {
     }
 }
 
-/// Covers `piece` from `start` (a share of its length) with the longest
-/// span up to `hi` that one cubic fits, pushed to `out`, and returns where
-/// the span ends: the whole `start..hi` if it fits; else halved until one
-/// fits, then bisected between that success and the failure above it down
-/// to `share` of the span found (or half a pixel). When not even
-/// [`MIN_SPAN_PX`] fits, the polygon over that length (it lies on what is
-/// fitted).
-pub(super) fn longest_span(
-    piece: &Piece,
-    start: f64,
-    hi: f64,
-    share: f64,
-    accuracy: f64,
-    out: &mut Vec<CubicBez>,
-) -> f64 {
-    if let Some(c) = fit_span(piece, start..hi, accuracy) {
-        out.push(c);
-        return hi;
-    }
-    let total = piece.length();
-    let min_span = (MIN_SPAN_PX / total).min(1.0);
-    // Halve until one cubic fits.
-    let mut fail = hi;
-    let mut ok: Option<(f64, CubicBez)> = None;
-    let mut end = 0.5 * (start + fail);
-    while end - start >= min_span {
-        if let Some(c) = fit_span(piece, start..end, accuracy) {
-            ok = Some((end, c));
-            break;
-        }
-        fail = end;
-        end = 0.5 * (start + end);
-    }
-    let Some((mut good, mut cubic)) = ok else {
-        // Nothing fits even a short span: the polygon up to there.
-        let end = (start + min_span).min(1.0);
-        polygon(piece, start..end, out);
-        return end;
-    };
-    // Bisect between the success and the failure above it.
-    while (fail - good) * total > (share * (good - start) * total).max(0.5) {
-        let mid = 0.5 * (good + fail);
-        match fit_span(piece, start..mid, accuracy) {
-            Some(c) => {
-                good = mid;
-                cubic = c;
-            }
-            None => fail = mid,
-        }
-    }
-    out.push(cubic);
-    good
-}
-
-/// One cubic for `range`: the fitted one if it passes [`fit_checked`], else
-/// the straight chord if the outline and the level set stay within
-/// [`CHORD_SHARE`] × `accuracy` of it (short
-/// spans of a noisy outline, where the end tangents disagree with the
-/// chord and no cubic passes, are usually this).
-pub(super) fn fit_span(piece: &Piece, range: Range<f64>, accuracy: f64) -> Option<CubicBez> {
-    fit_checked(piece, range.clone(), accuracy).or_else(|| {
-        let s0 = range.start * piece.length();
-        let s1 = range.end * piece.length();
-        let a = piece.locate(s0).1;
-        let b = piece.locate(s1).1;
-        let chord = kurbo::Line::new(a, b);
-        // The vertices strictly inside (s0, s1): `cum` ascends.
-        let lo = piece.cum.partition_point(|&c| c <= s0);
-        let hi = piece.cum.partition_point(|&c| c < s1).max(lo);
-        let within = piece.pts[lo..hi].iter().all(|&p| {
-            crate::raster::sdf::point_segment_distance(p, chord)
-                <= piece.reach(CHORD_SHARE * accuracy)
-        });
-        let on_level_set = || {
-            piece.holds(
-                (1..64).map(|k| a.lerp(b, k as f64 / 64.0)),
-                s0,
-                s1,
-                CHORD_SHARE * accuracy,
-            )
-        };
-        (a != b && within && on_level_set()).then(|| line_cubic(a, b))
-    })
-}
-
-/// The share of the accuracy a straight chord may use (see [`fit_span`]).
-const CHORD_SHARE: f64 = 0.6;
-
-/// Appends the piece's polygon over `range` as straight cubics.
-pub(super) fn polygon(piece: &Piece, range: Range<f64>, out: &mut Vec<CubicBez>) {
-    let s0 = range.start * piece.length();
-    let s1 = range.end * piece.length();
-    let mut prev = piece.locate(s0).1;
-    for (i, &c) in piece.cum.iter().enumerate() {
-        if c > s0 && c < s1 {
-            out.push(line_cubic(prev, piece.pts[i]));
-            prev = piece.pts[i];
-        }
-    }
-    let end = piece.locate(s1).1;
-    if end != prev {
-        out.push(line_cubic(prev, end));
-    }
-}
-
-/// Parameter span (of the piece's 0..1) below which a range is not split
-/// further but kept as a polygon.
-pub(super) const MIN_SPAN_PX: f64 = 1.5;
-
-/// One cubic for `range` of the piece, if kurbo finds one within `accuracy`
-/// that also stays within `accuracy` + [`CHECK_SLACK`] of the SDF's zero
-/// level at 16 points and does not loop away (arc length at most 1.5× the
-/// source's).
-fn fit_checked(piece: &Piece, range: Range<f64>, accuracy: f64) -> Option<CubicBez> {
-    let len = piece.length() * (range.end - range.start);
-    if is_spicy(piece, range.clone()) {
-        return None;
-    }
-    let (c, _) = kurbo::fit_to_cubic(piece, range.clone(), piece.reach(accuracy))?;
-    let c = Affine::translate(piece.origin) * c;
-    let s0 = range.start * piece.length();
-    let s1 = range.end * piece.length();
-    let ok = piece.holds((1..64).map(|k| c.eval(k as f64 / 64.0)), s0, s1, accuracy)
-        && c.arclen(0.01) <= 1.5 * len + 0.5
-        && piece.keeps_handles_on_canvas(&c);
-    ok.then_some(c)
-}
-
-/// True when kurbo would judge the range "spicy" (tangents of neighbouring
-/// error samples more than about 11° apart) and fall back to measuring
-/// error by arc length at 1e-9 accuracy, which is very slow; such ranges
-/// are split first.
-fn is_spicy(piece: &Piece, range: Range<f64>) -> bool {
-    const N: usize = 22;
-    let step = (range.end - range.start) / (N - 1) as f64;
-    let mut last: Option<Vec2> = None;
-    for i in 0..N {
-        let t = piece
-            .sample_pt_tangent(range.start + i as f64 * step, 1.0)
-            .tangent;
-        if let Some(l) = last {
-            if t.cross(l).abs() > 0.2 * t.dot(l).abs() {
-                return true;
-            }
-        }
-        last = Some(t);
-    }
-    false
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::raster::Grid;
     use crate::trace::contour;
-    use kurbo::Affine;
+    use kurbo::{Affine, ParamCurve};
 
     pub(crate) fn disc_sdf(size: usize, cx: f64, cy: f64, r: f64) -> Sdf {
         Sdf {

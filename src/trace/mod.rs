@@ -13,8 +13,10 @@
 pub mod contour;
 pub mod corner;
 pub mod cover;
+mod direct;
 pub mod fit;
 mod nearest;
+mod span;
 
 use crate::error::{Error, Result};
 use crate::raster::binary::SmoothLoop;

@@ -73,6 +73,21 @@ fn gallop(c: &[f64], target: f64) -> usize {
         .map_or(0, |c| c.partition_point(|&x| x < target))
 }
 
+/// The number of leading values of ascending `c` at or below `target`,
+/// by doubling steps and then bisecting ([`crate::trace::fit`]'s `locate`
+/// walks forwards from the segment it found last).
+pub(super) fn gallop_le(c: &[f64], target: f64) -> usize {
+    let (mut lo, mut hi) = (0usize, 1usize);
+    while hi <= c.len() && c[hi - 1] <= target {
+        lo = hi;
+        hi *= 2;
+    }
+    let hi = hi.min(c.len());
+    lo + c
+        .get(lo..hi)
+        .map_or(0, |c| c.partition_point(|&x| x <= target))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -87,6 +102,7 @@ mod tests {
         fn gallop_is_partition_point(mut c in prop::collection::vec(0.0f64..100.0, 0..60), t in -1.0f64..101.0) {
             c.sort_by(|a, b| a.total_cmp(b));
             prop_assert_eq!(gallop(&c, t), c.partition_point(|&x| x < t));
+            prop_assert_eq!(gallop_le(&c, t), c.partition_point(|&x| x <= t));
         }
 
         /// The segment search with skips by arc length answers as a scan

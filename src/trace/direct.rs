@@ -1,0 +1,417 @@
+//! One cubic for one span of an exact outline, fitted directly (the
+//! outline path of [`super::cover`]; SDF contours keep kurbo's
+//! `fit_to_cubic`).
+//!
+//! With the end points and end tangents fixed, a cubic has two free
+//! numbers, its handle lengths. They are chosen so that the cubic encloses
+//! the same signed area with the chord as the outline does, and has the
+//! same first moment of that area along the chord (Levien, "Fitting cubic
+//! Bézier curves", 2021: area and moment matching). In the frame where the
+//! chord runs from (0, 0) to (1, 0), with the start tangent at angle θ₀
+//! above the chord and the end tangent at θ₁ below it, the handles are
+//! `p1 = d₀(cos θ₀, sin θ₀)` and `p2 = (1 − d₁ cos θ₁, d₁ sin θ₁)`; the
+//! area `∫ y dx = 3/20 (2 d₀ sin θ₀ + 2 d₁ sin θ₁ − d₀ d₁ sin(θ₀ + θ₁))`
+//! is bilinear, so it gives `d₁` from `d₀`, and the moment `∫ x y dx`
+//! (quadratic in each handle) then becomes a quartic in `d₀`
+//! ([`handle_lengths`], derived symbolically, checked against kurbo's
+//! fitter in the tests). Each candidate is judged by the outline itself: the
+//! outline's samples must lie near the curve and the curve near the
+//! outline (`Piece::holds`), which is all the fitter is held to, so no
+//! separate error measure along normals is needed.
+
+use super::fit::Piece;
+use super::nearest::nearest_segment;
+use super::span::FIT_SAMPLES;
+use kurbo::common::{factor_quartic_inner, solve_cubic, solve_quadratic};
+use kurbo::{CubicBez, ParamCurve, Point, Vec2};
+
+/// Handle lengths `(d₀, d₁)` (in chord lengths, both ≥ 0) of the cubics
+/// with unit chord, end tangents at `th0` above and `th1` below the chord
+/// (given as `(sin, cos)` pairs), whose signed area with the chord is
+/// `area` and whose moment `∫ x y dx` is `mx` (see the module docs).
+/// Every real root of the quartic is a candidate; a complex pair
+/// contributes its real part (the nearest miss). A root whose other handle
+/// comes out negative becomes the one-handle cubic that still honours
+/// both tangents: its handle at the apex of the tangent triangle.
+pub(super) fn handle_lengths(
+    (s0, c0): (f64, f64),
+    (s1, c1): (f64, f64),
+    area: f64,
+    mx: f64,
+) -> ([(f64, f64); 4], usize) {
+    let (a, m) = (area, mx);
+    let s01 = c0 * s1 + c1 * s0; // sin(θ₀ + θ₁)
+                                 // The moment residual times (3 d₀ sin(θ₀+θ₁) − 6 sin θ₁)², scaled
+                                 // by 280: coefficients of d₀⁰ … d₀⁴.
+    let q0 = 240.0 * s1 * (25.0 * a * s1 - 25.0 * a * a * c1 - 42.0 * m * s1);
+    let q1 = -48.0
+        * (-75.0 * a * a * c1 * (c0 * s1 + c1 * s0)
+            + 85.0 * a * c0 * s1 * s1
+            + 70.0 * a * c1 * s0 * s1
+            - 210.0 * m * s1 * (c0 * s1 + c1 * s0)
+            + 12.0 * s0 * s1 * s1);
+    let q2 = 36.0
+        * (-5.0 * a * (3.0 * c0 * c0 * s1 * s1 + 4.0 * c0 * c1 * s0 * s1 + c1 * c1 * s0 * s0)
+            - 70.0 * m * s01 * s01
+            + 15.0 * c0 * s0 * s1 * s1
+            + 9.0 * c1 * s0 * s0 * s1);
+    let q3 = 36.0 * s01 * (15.0 * a * c0 * s01 - 2.0 * c0 * s0 * s1 + c1 * s0 * s0);
+    let q4 = -27.0 * c0 * s0 * s01 * s01;
+    let mut roots = [0.0; 4];
+    let mut n = 0;
+    let mut push = |r: f64| {
+        if n < 4 {
+            roots[n] = r;
+            n += 1;
+        }
+    };
+    const EPS: f64 = 1e-12;
+    if q4.abs() > EPS {
+        if let Some(quads) = factor_quartic_inner(q3 / q4, q2 / q4, q1 / q4, q0 / q4, false) {
+            for (b, c) in quads {
+                let rs = solve_quadratic(c, b, 1.0);
+                if rs.is_empty() {
+                    push(-0.5 * b);
+                }
+                for r in rs {
+                    push(r);
+                }
+            }
+        }
+    } else if q3.abs() > EPS {
+        solve_cubic(q0, q1, q2, q3).into_iter().for_each(&mut push);
+    } else if q2.abs() > EPS || q1.abs() > EPS || q0.abs() > EPS {
+        solve_quadratic(q0, q1, q2).into_iter().for_each(&mut push);
+    } else {
+        return (
+            [(1.0 / 3.0, 1.0 / 3.0), (0.0, 0.0), (0.0, 0.0), (0.0, 0.0)],
+            1,
+        );
+    }
+    let mut out = [(0.0, 0.0); 4];
+    let mut k = 0;
+    for &d0 in &roots[..n] {
+        let (d0, d1) = if d0 > 0.0 {
+            // The area, solved for d₁.
+            let d1 = (6.0 * d0 * s0 - 20.0 * a) / (3.0 * d0 * s01 - 6.0 * s1);
+            if d1 > 0.0 {
+                (d0, d1)
+            } else {
+                (s1 / s01, 0.0)
+            }
+        } else {
+            (0.0, s0 / s01)
+        };
+        if d0 >= 0.0 && d1 >= 0.0 && d0.is_finite() && d1.is_finite() {
+            out[k] = (d0, d1);
+            k += 1;
+        }
+    }
+    (out, k)
+}
+
+/// A span in the unit-chord frame of [`handle_lengths`].
+struct Frame {
+    /// End points (px).
+    p0: Point,
+    p3: Point,
+    /// Unit chord direction and chord length (px).
+    u: Vec2,
+    chord: f64,
+    /// `(sin, cos)` of the start tangent's angle above the chord and of the
+    /// end tangent's below it.
+    th0: (f64, f64),
+    th1: (f64, f64),
+    /// Signed area and x moment of the outline with the chord, in the
+    /// frame (chord lengths² and ³).
+    area: f64,
+    mx: f64,
+}
+
+impl Frame {
+    /// The frame of `range` of `piece`, `None` for a span without a chord.
+    fn new(piece: &Piece, range: std::ops::Range<f64>) -> Option<Frame> {
+        let (p0, t0) = piece.end_sample(range.start, true);
+        let (p3, t1) = piece.end_sample(range.end, false);
+        let d = p3 - p0;
+        let chord2 = d.hypot2();
+        if chord2 <= 1e-18 {
+            return None;
+        }
+        let chord = chord2.sqrt();
+        let u = d / chord;
+        // The outline's integrals minus the chord's, taken about the start
+        // point, the moment vector rotated onto the chord.
+        let [area, mxx, myy] = piece.span_moments(range, p0, p3);
+        Some(Frame {
+            p0,
+            p3,
+            u,
+            chord,
+            th0: (u.cross(t0), u.dot(t0)),
+            th1: (t1.cross(u), t1.dot(u)),
+            area: area / chord2,
+            mx: (u.x * mxx + u.y * myy) / (chord2 * chord),
+        })
+    }
+}
+
+/// Handles longer than this share of the chord make a candidate's error
+/// count for more (long handles are where a cubic starts to loop).
+const HANDLE_ELBOW: f64 = 0.65;
+
+/// How much more: the error scales by `1 + 2 (d − elbow)` beyond it.
+const HANDLE_SLOPE: f64 = 2.0;
+
+/// Points checked on a candidate: first every eighth (a cheap rejection of
+/// most misfits), then the rest.
+const CURVE_POINTS: usize = 64;
+
+/// The cubic matching `piece`'s area and moment over `range` (shares of its
+/// length) that lies within `accuracy` of the outline both ways: each of
+/// the outline's [`FIT_SAMPLES`] samples (`samples`, interior ones used)
+/// within the piece's reach of the curve, and the curve within `accuracy`
+/// of the outline (`Piece::holds`, which also admits the corridor), checked
+/// on the candidate with the smallest outline-to-curve error (long handles
+/// penalised as above; trying the others too cost thin-line art accuracy:
+/// they are the loops and hooks).
+pub(super) fn fit_span_direct(
+    piece: &Piece,
+    range: std::ops::Range<f64>,
+    samples: &[(Point, Vec2); FIT_SAMPLES],
+    accuracy: f64,
+) -> Option<CubicBez> {
+    let f = Frame::new(piece, range.clone())?;
+    let (p0, p3, u, chord, th0, th1) = (f.p0, f.p3, f.u, f.chord, f.th0, f.th1);
+    let reach = piece.reach(accuracy);
+    let (cands, k) = handle_lengths(th0, th1, f.area, f.mx);
+    let v = Vec2::new(-u.y, u.x);
+    let to_world = |x: f64, y: f64| p0 + chord * (x * u + y * v);
+    // The best candidate: the smallest outline-to-curve error, scaled up
+    // for long handles; a candidate is only measured while it can still
+    // beat the best so far.
+    let mut best: Option<(f64, CubicBez, CurvePoints)> = None;
+    for &(d0, d1) in &cands[..k] {
+        let c = CubicBez::new(
+            p0,
+            to_world(d0 * th0.1, d0 * th0.0),
+            to_world(1.0 - d1 * th1.1, d1 * th1.0),
+            p3,
+        );
+        let scale = |d: f64| 1.0 + (d - HANDLE_ELBOW).max(0.0) * HANDLE_SLOPE;
+        let scale = scale(d0).max(scale(d1));
+        let bound = best.as_ref().map_or(reach, |b| b.0.min(reach));
+        let pts = CurvePoints::new(&c);
+        if let Some(err) = outline_to_curve(&pts, samples, bound / scale) {
+            if best.as_ref().is_none_or(|b| err * scale < b.0) {
+                best = Some((err * scale, c, pts));
+            }
+        }
+    }
+    let (_, c, pts) = best?;
+    let len = piece.length() * (range.end - range.start);
+    let (s0, s1) = (range.start * piece.length(), range.end * piece.length());
+    // Coarse first: most misfits fail at one of every eighth point.
+    let inner = &pts.pts[1..CURVE_POINTS];
+    let coarse = inner.iter().skip(7).step_by(8).copied();
+    let fine = inner
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| k % 8 != 7)
+        .map(|(_, &p)| p);
+    // The flattened length bounds the arc length from below, the control
+    // polygon from above.
+    let polygon = (c.p1 - c.p0).hypot() + (c.p2 - c.p1).hypot() + (c.p3 - c.p2).hypot();
+    let short = polygon <= 1.5 * len + 0.5
+        || pts.cum[CURVE_POINTS] <= 1.5 * len + 0.5
+            && kurbo::ParamCurveArclen::arclen(&c, 0.01) <= 1.5 * len + 0.5;
+    (short && piece.holds(coarse, s0, s1, accuracy) && piece.holds(fine, s0, s1, accuracy))
+        .then_some(c)
+}
+
+/// A cubic flattened at [`CURVE_POINTS`] + 1 evenly spaced parameters,
+/// with the cumulative length (px) of the chords.
+struct CurvePoints {
+    pts: [Point; CURVE_POINTS + 1],
+    cum: [f64; CURVE_POINTS + 1],
+}
+
+impl CurvePoints {
+    fn new(c: &CubicBez) -> Self {
+        let mut pts = [Point::ORIGIN; CURVE_POINTS + 1];
+        let mut cum = [0.0; CURVE_POINTS + 1];
+        for k in 0..=CURVE_POINTS {
+            pts[k] = c.eval(k as f64 / CURVE_POINTS as f64);
+            if k > 0 {
+                cum[k] = cum[k - 1] + (pts[k] - pts[k - 1]).hypot();
+            }
+        }
+        CurvePoints { pts, cum }
+    }
+}
+
+/// How far (share of the curve's length, beyond twice the distance
+/// allowed) a sample may land along the curve from where its share of the
+/// outline's length puts it.
+const STEP_SLACK: f64 = 0.15;
+
+/// The largest distance (px) from the interior outline samples to the
+/// flattened curve, or `None` once one
+/// exceeds `limit`. Each sample's first chord within `limit` is searched
+/// from the last one found (samples and curve both run from start to end;
+/// chords out of reach are skipped by their arc length, see
+/// [`nearest_segment`]), then followed downhill to a local minimum: an upper
+/// bound of the distance, exact where the curve is smooth.
+fn outline_to_curve(curve: &CurvePoints, samples: &[(Point, Vec2)], limit: f64) -> Option<f64> {
+    let (pts, cum) = (&curve.pts, &curve.cum);
+    let dist = |q: Point, j: usize| {
+        crate::raster::sdf::point_segment_distance(q, kurbo::Line::new(pts[j], pts[j + 1]))
+    };
+    let last = CURVE_POINTS - 1;
+    let mut cursor = 0usize;
+    let mut worst: f64 = 0.0;
+    let interior = samples
+        .get(1..samples.len().saturating_sub(1))
+        .unwrap_or(&[]);
+    let total = cum[CURVE_POINTS];
+    let slack = 2.0 * limit + STEP_SLACK * total;
+    for (i, &(q, _)) in interior.iter().enumerate() {
+        let found = match nearest_segment(pts, cum, q, cursor, last, limit, limit) {
+            (Some(j), d) => Some((j, d)),
+            _ if cursor > 0 => match nearest_segment(pts, cum, q, 0, cursor - 1, limit, limit) {
+                (Some(j), d) => Some((j, d)),
+                _ => None,
+            },
+            _ => None,
+        };
+        let (mut j, mut best) = found?;
+        // Downhill to the nearest chord around it.
+        loop {
+            let fwd = if j < last {
+                dist(q, j + 1)
+            } else {
+                f64::INFINITY
+            };
+            let back = if j > 0 { dist(q, j - 1) } else { f64::INFINITY };
+            if fwd < best && fwd <= back {
+                best = fwd;
+                j += 1;
+            } else if back < best {
+                best = back;
+                j -= 1;
+            } else {
+                break;
+            }
+        }
+        // Where along the curve the sample landed, against where it would
+        // at the same share of the curve's length: a curve that doubles
+        // back can lie close to the outline both ways and still not follow
+        // it in order (a discrete Fréchet test).
+        let seg = pts[j + 1] - pts[j];
+        let along =
+            cum[j] + (q - pts[j]).dot(seg).clamp(0.0, seg.hypot2()) / seg.hypot().max(1e-12);
+        let share = (i + 1) as f64 / (interior.len() + 1) as f64;
+        if (along - share * total).abs() > slack {
+            return None;
+        }
+        cursor = j;
+        worst = worst.max(best);
+    }
+    Some(worst)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::trace::fit::Guide;
+
+    /// A piece along `f(t)`, t in 0..1, at `n` + 1 points, with the exact
+    /// tangents `df`.
+    fn analytic(n: usize, f: impl Fn(f64) -> Point, df: impl Fn(f64) -> Vec2) -> Piece<'static> {
+        let ts = (0..=n).map(|i| i as f64 / n as f64);
+        Piece::new(
+            ts.clone().map(&f).collect(),
+            ts.map(|t| df(t).normalize()).collect(),
+            Guide::Outline(None),
+            false,
+            false,
+        )
+    }
+
+    /// Handle lengths (chord lengths) of a cubic.
+    fn handles(c: &CubicBez) -> (f64, f64) {
+        let chord = (c.p3 - c.p0).hypot();
+        ((c.p1 - c.p0).hypot() / chord, (c.p3 - c.p2).hypot() / chord)
+    }
+
+    /// kurbo's fitter, given the same source, finds one of our candidates.
+    fn agrees_with_kurbo(piece: &Piece, range: std::ops::Range<f64>) {
+        let (kc, _) = kurbo::fit_to_cubic(piece, range.clone(), 1.0).expect("kurbo fits");
+        let (k0, k1) = handles(&kc);
+        let f = Frame::new(piece, range.clone()).expect("a chord");
+        let (cands, n) = handle_lengths(f.th0, f.th1, f.area, f.mx);
+        assert!(
+            cands[..n]
+                .iter()
+                .any(|&(d0, d1)| (d0 - k0).abs() < 1e-6 && (d1 - k1).abs() < 1e-6),
+            "{range:?}: kurbo ({k0}, {k1}), ours {:?}",
+            &cands[..n]
+        );
+    }
+
+    #[test]
+    fn circular_arcs_match_kurbo() {
+        for (r, sweep) in [(40.0, 1.0), (10.0, 2.0), (200.0, 0.3), (25.0, 2.8)] {
+            let piece = analytic(
+                400,
+                |t| Point::new(300.0 + r * (sweep * t).cos(), 200.0 + r * (sweep * t).sin()),
+                |t| Vec2::new(-(sweep * t).sin(), (sweep * t).cos()),
+            );
+            agrees_with_kurbo(&piece, 0.0..1.0);
+            agrees_with_kurbo(&piece, 0.2..0.7);
+        }
+    }
+
+    #[test]
+    fn sine_polyline_matches_kurbo() {
+        // Asymmetric end tangents, an inflection-free stretch and one
+        // with an inflection (the quartic's other roots).
+        let piece = analytic(
+            300,
+            |t| Point::new(10.0 + 60.0 * t, 50.0 + 12.0 * (3.0 * t).sin()),
+            |t| Vec2::new(60.0, 36.0 * (3.0 * t).cos()),
+        );
+        for range in [0.0..0.5, 0.1..0.45, 0.3..0.9, 0.0..1.0] {
+            agrees_with_kurbo(&piece, range);
+        }
+    }
+
+    #[test]
+    fn a_circular_arc_is_fitted_within_the_accuracy() {
+        // A quarter circle of radius 50 px: one cubic is within 0.014 px.
+        let piece = analytic(
+            500,
+            |t| {
+                Point::new(
+                    100.0 + 50.0 * (1.5 * t).cos(),
+                    100.0 + 50.0 * (1.5 * t).sin(),
+                )
+            },
+            |t| Vec2::new(-(1.5 * t).sin(), (1.5 * t).cos()),
+        );
+        let samples = piece.samples(0.0..1.0);
+        let c = fit_span_direct(&piece, 0.0..1.0, &samples, 0.1).expect("fits");
+        for k in 0..=100 {
+            let p = c.eval(k as f64 / 100.0);
+            assert!(((p - Point::new(100.0, 100.0)).hypot() - 50.0).abs() < 0.03);
+        }
+        // A wavy source is not one cubic.
+        let wavy = analytic(
+            600,
+            |t| Point::new(10.0 + 100.0 * t, 50.0 + 8.0 * (9.0 * t).sin()),
+            |t| Vec2::new(100.0, 72.0 * (9.0 * t).cos()),
+        );
+        let samples = wavy.samples(0.0..1.0);
+        assert!(fit_span_direct(&wavy, 0.0..1.0, &samples, 0.25).is_none());
+    }
+}
