@@ -69,7 +69,7 @@ pub(super) fn longest_span(
     let Some((mut good, mut cubic)) = ok else {
         // Nothing fits even a short span: the polygon up to there.
         let end = (start + min_span).min(1.0);
-        polygon(piece, start..end, out);
+        polygon(piece, start..end, accuracy, out);
         return end;
     };
     // Bisect between the success and the failure above it.
@@ -121,20 +121,64 @@ pub(super) fn fit_span(piece: &Piece, range: Range<f64>, accuracy: f64) -> Optio
 /// The share of the accuracy a straight chord may use (see [`fit_span`]).
 const CHORD_SHARE: f64 = 0.6;
 
-/// Appends the piece's polygon over `range` as straight cubics.
-pub(super) fn polygon(piece: &Piece, range: Range<f64>, out: &mut Vec<CubicBez>) {
+/// Appends the piece's polygon over `range` as straight cubics, simplified
+/// to the fewest of its vertices that keep every other one within
+/// `accuracy` px, each line also checked against what the piece is fitted
+/// to (Douglas–Peucker). The span is a sharp turn no cubic follows (a thin
+/// line's pointed end, a corner too tight to be found): its flattened
+/// outline alone held 5–10 lines a tenth of a pixel long.
+pub(super) fn polygon(piece: &Piece, range: Range<f64>, accuracy: f64, out: &mut Vec<CubicBez>) {
     let s0 = range.start * piece.length();
     let s1 = range.end * piece.length();
-    let mut prev = piece.locate(s0).1;
+    // The vertices with their arc lengths.
+    let mut pts = vec![(piece.locate(s0).1, s0)];
     for (i, &c) in piece.cum.iter().enumerate() {
         if c > s0 && c < s1 {
-            out.push(line_cubic(prev, piece.pts[i]));
-            prev = piece.pts[i];
+            pts.push((piece.pts[i], c));
         }
     }
     let end = piece.locate(s1).1;
-    if end != prev {
-        out.push(line_cubic(prev, end));
+    if pts.last().map(|p| p.0) != Some(end) {
+        pts.push((end, s1));
+    }
+    let mut keep = vec![false; pts.len()];
+    keep[0] = true;
+    keep[pts.len() - 1] = true;
+    simplify(piece, &pts, 0, pts.len() - 1, accuracy, &mut keep);
+    let mut prev = pts[0].0;
+    for (&(p, _), _) in pts.iter().zip(&keep).skip(1).filter(|(_, &k)| k) {
+        if p != prev {
+            out.push(line_cubic(prev, p));
+            prev = p;
+        }
+    }
+}
+
+/// Douglas–Peucker between kept vertices `a` and `b` of `pts` (points with
+/// their arc lengths on the piece): the chord stands when every vertex
+/// between is within `tol` px of it and it holds against the piece;
+/// otherwise the vertex farthest from it is kept and both halves tried.
+fn simplify(piece: &Piece, pts: &[(Point, f64)], a: usize, b: usize, tol: f64, keep: &mut [bool]) {
+    if b <= a + 1 {
+        return;
+    }
+    let chord = kurbo::Line::new(pts[a].0, pts[b].0);
+    let (far, d) = (a + 1..b)
+        .map(|i| {
+            (
+                i,
+                crate::raster::sdf::point_segment_distance(pts[i].0, chord),
+            )
+        })
+        .fold((a, -1.0), |best, x| if x.1 > best.1 { x } else { best });
+    let holds = || {
+        let samples = (1..16).map(|k| chord.eval(k as f64 / 16.0));
+        piece.holds(samples, pts[a].1, pts[b].1, tol)
+    };
+    if d > tol || !holds() {
+        keep[far] = true;
+        simplify(piece, pts, a, far, tol, keep);
+        simplify(piece, pts, far, b, tol, keep);
     }
 }
 
@@ -180,4 +224,42 @@ fn is_spicy(samples: &[(Point, Vec2); FIT_SAMPLES]) -> bool {
     samples
         .windows(2)
         .any(|w| w[1].1.cross(w[0].1).abs() > 0.2 * w[1].1.dot(w[0].1).abs())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use kurbo::ParamCurveNearest;
+
+    /// The fallback polygon over a tight turn (a flattened half circle of
+    /// radius 0.4 px, 24 points) is a handful of lines, every vertex of the
+    /// outline within the accuracy of them.
+    #[test]
+    fn fallback_polygon_is_simplified_within_accuracy() {
+        let pts: Vec<Point> = (0..24)
+            .map(|k| {
+                let a = std::f64::consts::PI * k as f64 / 23.0;
+                Point::new(10.0 + 0.4 * a.cos(), 10.0 + 0.4 * a.sin())
+            })
+            .collect();
+        let tangents: Vec<Vec2> = (0..24)
+            .map(|k| {
+                let a = std::f64::consts::PI * k as f64 / 23.0;
+                Vec2::new(-a.sin(), a.cos())
+            })
+            .collect();
+        let piece = Piece::new(pts.clone(), tangents, Guide::Outline(None), false, false);
+        let mut out = Vec::new();
+        polygon(&piece, 0.0..1.0, 0.25, &mut out);
+        assert!(out.len() <= 3, "{} lines", out.len());
+        assert_eq!(out[0].p0, pts[0]);
+        assert_eq!(out[out.len() - 1].p3, pts[23]);
+        for p in &pts {
+            let d = out
+                .iter()
+                .map(|c| (c.eval(c.nearest(*p, 1e-9).t) - *p).hypot())
+                .fold(f64::INFINITY, f64::min);
+            assert!(d <= 0.25 + 1e-9, "{p:?} {d} px from the polygon");
+        }
+    }
 }
