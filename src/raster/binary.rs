@@ -8,8 +8,9 @@
 //! the staircase is replaced by the simplest curve consistent with it:
 //!
 //! 1. **Paths.** The boundary of the ink as closed loops through the
-//!    midpoints of the pixel edges (marching squares on the ±½ field, ties
-//!    joining the ink as everywhere in flourish).
+//!    midpoints of the pixel edges (the loops of marching squares on the
+//!    ±½ field, ties joining the ink as everywhere in flourish), walked on
+//!    the bits ([`paths`]).
 //! 2. **Straight runs.** For every vertex `i`, the furthest vertex `j` such
 //!    that the segment `i → j` passes within [`STRAIGHT_TOLERANCE`] of every
 //!    vertex between them and every step advances along it (a cone of
@@ -45,8 +46,8 @@
 //! inside of pixel centres taken from the curves (not from the bitmap), so
 //! the sign and the distance agree.
 
+use crate::raster::paths::{self, Bitmap};
 use crate::raster::{Coverage, Grid, Sdf};
-use crate::trace::contour;
 use kurbo::{CubicBez, ParamCurve, ParamCurveDeriv, Point, Vec2};
 use rayon::prelude::*;
 
@@ -86,20 +87,23 @@ pub struct SmoothLoop {
 /// The smoothed outline of binary coverage `cov` as [`SmoothLoop`]s with
 /// tangents and corners: what `flourish trace` fits Béziers to directly.
 /// Outer loops are counter-clockwise in the y-down sense of
-/// [`contour::Contour::signed_area`] > 0, holes the other way.
+/// [`crate::trace::contour::Contour::signed_area`] > 0, holes the other way.
 pub fn smooth_loops(cov: &Coverage) -> Vec<SmoothLoop> {
-    let values = cov.map(|c| if c >= 0.5 { -0.5 } else { 0.5 });
-    let contours = contour::extract(&values);
-    contours
+    bitmap_loops(&Bitmap::from_coverage(cov))
+}
+
+/// [`smooth_loops`] of a bitmap's ink.
+pub fn bitmap_loops(bits: &Bitmap) -> Vec<SmoothLoop> {
+    paths::paths(bits)
         .par_iter()
-        .map(|c| smooth_loop(&c.points))
+        .map(|p| smooth_loop(p))
         .filter(|l| l.points.len() >= 3)
         .collect()
 }
 
 /// The smoothed outline of binary coverage `cov`: closed polylines in pixel
 /// coordinates (outer loops counter-clockwise in the y-down sense of
-/// [`contour::Contour::signed_area`] > 0, holes the other way).
+/// [`crate::trace::contour::Contour::signed_area`] > 0, holes the other way).
 pub fn smooth_outline(cov: &Coverage) -> Vec<Vec<Point>> {
     smooth_loops(cov).into_iter().map(|l| l.points).collect()
 }
@@ -797,6 +801,7 @@ pub fn inside(w: usize, h: usize, loops: &[Vec<Point>]) -> Grid<bool> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::trace::contour;
 
     fn disc(n: usize, cx: f64, cy: f64, r: f64) -> Coverage {
         Grid::from_fn(n, n, |x, y| {

@@ -148,13 +148,21 @@ pub fn load_traceable(path: &Path, opts: &InputOptions) -> Result<Traceable> {
         return load_svg(path, &bytes, opts).map(Traceable::Field);
     }
     match raster_coverage(path, &bytes, opts)? {
-        RasterCoverage::Binary { w, h, color, cov } => Ok(Traceable::Outline(OutlineInk {
-            width: w as f64,
-            height: h as f64,
-            color,
-            loops: super::binary::smooth_loops(&cov),
-            corridor: Some(super::corridor::Corridor::new(&cov)),
-        })),
+        RasterCoverage::Binary { w, h, color, cov } => {
+            let bits = super::paths::Bitmap::from_coverage(&cov);
+            // The corridor is built while the loops are smoothed.
+            let (loops, corridor) = rayon::join(
+                || super::binary::bitmap_loops(&bits),
+                || super::corridor::Corridor::from_bitmap(&bits),
+            );
+            Ok(Traceable::Outline(OutlineInk {
+                width: w as f64,
+                height: h as f64,
+                color,
+                loops,
+                corridor: Some(corridor),
+            }))
+        }
         // One anti-aliased layer: its sub-pixel outline, fitted directly.
         RasterCoverage::Layers { w, h, layers } if layers.len() == 1 && !opts.layers => {
             let (color, cov) = &layers[0];

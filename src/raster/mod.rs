@@ -7,6 +7,7 @@ pub mod corridor;
 pub mod cull;
 pub mod edt;
 pub mod input;
+pub mod paths;
 pub mod plain;
 pub mod scan;
 pub mod sdf;
