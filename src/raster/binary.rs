@@ -386,12 +386,63 @@ fn run_from(path: &[Point], i: usize) -> usize {
 
 /// Step 3: the polygon with fewest straight edges, as path indices in order.
 fn optimal_polygon(mut lon: impl FnMut(usize) -> usize, n: usize) -> Vec<usize> {
+    // The greedy cover from `start`: how many vertices it has, counting up
+    // to `limit` at most, and them in order into `out` when given.
+    let mut cover = |start: usize, limit: usize, mut out: Option<&mut Vec<usize>>| -> usize {
+        if let Some(o) = out.as_deref_mut() {
+            o.push(start);
+        }
+        let mut count = 1;
+        let mut at = 0usize; // steps from start
+        let mut i = start; // (start + at) mod n
+        while count < limit {
+            let step = lon(i).max(1);
+            at += step;
+            if at >= n {
+                break;
+            }
+            // i, step < n: one wrap at most.
+            i += step;
+            if i >= n {
+                i -= n;
+            }
+            if let Some(o) = out.as_deref_mut() {
+                o.push(i);
+            }
+            count += 1;
+        }
+        count
+    };
+    // The first start with the fewest vertices; a cover stops counting as
+    // soon as it cannot beat the best so far.
+    let tries = n.min(32);
+    let mut best: Option<(usize, usize)> = None;
+    for k in 0..tries {
+        let start = k * n / tries;
+        let limit = best.map_or(usize::MAX, |b| b.1);
+        let count = cover(start, limit, None);
+        if count < limit {
+            best = Some((start, count));
+        }
+    }
+    let mut out = Vec::new();
+    if let Some((start, count)) = best {
+        out.reserve(count);
+        cover(start, usize::MAX, Some(&mut out));
+    }
+    out
+}
+
+/// [`optimal_polygon`] as first written: every cover built in full, the
+/// first of fewest vertices kept. The reference the counting search must
+/// agree with.
+#[cfg(test)]
+fn optimal_polygon_reference(mut lon: impl FnMut(usize) -> usize, n: usize) -> Vec<usize> {
     let mut cover = |start: usize| -> Vec<usize> {
         let mut out = vec![start];
-        let mut at = 0usize; // steps from start
+        let mut at = 0usize;
         while at < n {
-            let i = (start + at) % n;
-            let step = lon(i).max(1);
+            let step = lon((start + at) % n).max(1);
             at += step;
             if at >= n {
                 break;
@@ -403,8 +454,7 @@ fn optimal_polygon(mut lon: impl FnMut(usize) -> usize, n: usize) -> Vec<usize> 
     let tries = n.min(32);
     let mut best: Option<Vec<usize>> = None;
     for k in 0..tries {
-        let start = k * n / tries;
-        let poly = cover(start);
+        let poly = cover(k * n / tries);
         if best.as_ref().is_none_or(|b| poly.len() < b.len()) {
             best = Some(poly);
         }
@@ -861,8 +911,34 @@ mod tests {
         }
     }
 
+    proptest::proptest! {
+        /// The counting search picks the same polygon as building every
+        /// cover in full, for any run lengths (ties between starts, runs
+        /// reaching past the start, runs of one).
+        #[test]
+        fn counted_covers_pick_the_reference_polygon(
+            lon in proptest::collection::vec(1usize..12, 1..200),
+            long in proptest::collection::vec(1usize..400, 0..4),
+        ) {
+            let mut lon = lon;
+            let n = lon.len();
+            for (k, &m) in long.iter().enumerate() {
+                let at = k * 37 % n;
+                lon[at] = m.min(n.saturating_sub(1)).max(1);
+            }
+            for l in lon.iter_mut() {
+                *l = (*l).min(n.saturating_sub(1)).max(1);
+            }
+            proptest::prop_assert_eq!(
+                optimal_polygon(|i| lon[i], n),
+                optimal_polygon_reference(|i| lon[i], n)
+            );
+        }
+    }
+
     /// The stretch-jumping walk gives the vertex-by-vertex runs exactly,
-    /// on the loops of random blobs (every kind of staircase and corner).
+    /// on the loops of random blobs (every kind of staircase and corner),
+    /// and the polygon search the reference's polygon.
     #[test]
     fn jumping_runs_equal_the_vertex_by_vertex_reference() {
         let mut seed = 0x9e3779b97f4a7c15u64;
@@ -902,6 +978,10 @@ mod tests {
                     assert_eq!(lon, run_from(path, i), "vertex {i} of {}", path.len());
                     checked += 1;
                 }
+                assert_eq!(
+                    optimal_polygon(|i| fast[i], path.len()),
+                    optimal_polygon_reference(|i| fast[i], path.len())
+                );
             }
         }
         assert!(checked > 5000, "only {checked} vertices");
