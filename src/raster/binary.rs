@@ -826,8 +826,13 @@ fn cubic_steps(c: &CubicBez) -> usize {
 /// The SDF of binary coverage read as its smoothed outline: distances to
 /// the curves of [`smooth_outline`], inside taken from the same curves.
 pub fn sdf(cov: &Coverage, to_user: kurbo::Affine) -> Sdf {
-    let loops = smooth_outline(cov);
-    let inside = inside(cov.width(), cov.height(), &loops);
+    bitmap_sdf(&Bitmap::from_coverage(cov), to_user)
+}
+
+/// [`sdf`] of a bitmap's ink.
+pub fn bitmap_sdf(bits: &Bitmap, to_user: kurbo::Affine) -> Sdf {
+    let loops: Vec<Vec<Point>> = bitmap_loops(bits).into_iter().map(|l| l.points).collect();
+    let inside = inside(bits.width(), bits.height(), &loops);
     let mut segments = Vec::new();
     for poly in &loops {
         let n = poly.len();

@@ -13,6 +13,7 @@
 //! (raster) is its own layer; layers are stacked bottom to top and each one
 //! extends under the layers above it, so stacked fills leave no seams.
 
+use super::paths::Bitmap;
 use super::{Coverage, Grid, Sdf};
 use crate::error::{Error, Result};
 use crate::io;
@@ -148,8 +149,7 @@ pub fn load_traceable(path: &Path, opts: &InputOptions) -> Result<Traceable> {
         return load_svg(path, &bytes, opts).map(Traceable::Field);
     }
     match raster_coverage(path, &bytes, opts)? {
-        RasterCoverage::Binary { w, h, color, cov } => {
-            let bits = super::paths::Bitmap::from_coverage(&cov);
+        RasterCoverage::Binary { w, h, color, bits } => {
             // The corridor is built while the loops are smoothed.
             let (loops, corridor) = rayon::join(
                 || super::binary::bitmap_loops(&bits),
@@ -184,12 +184,12 @@ pub fn load_traceable(path: &Path, opts: &InputOptions) -> Result<Traceable> {
 
 /// A decoded raster's ink coverage, before any SDF is built.
 enum RasterCoverage {
-    /// One layer of exactly 0/1 coverage.
+    /// One layer of exactly 0/1 coverage, as the bitmap of its ink.
     Binary {
         w: usize,
         h: usize,
         color: Color,
-        cov: Coverage,
+        bits: Bitmap,
     },
     /// Layers (bottom first) of fractional coverage.
     Layers {
@@ -205,12 +205,12 @@ impl RasterCoverage {
     fn into_ink(self) -> Ink {
         let to_user = Affine::IDENTITY;
         let (w, h, layers) = match self {
-            RasterCoverage::Binary { w, h, color, cov } => (
+            RasterCoverage::Binary { w, h, color, bits } => (
                 w,
                 h,
                 vec![InkLayer {
                     color,
-                    sdf: super::binary::sdf(&cov, to_user),
+                    sdf: super::binary::bitmap_sdf(&bits, to_user),
                 }],
             ),
             RasterCoverage::Layers { w, h, layers } => (
@@ -280,7 +280,8 @@ fn raster_coverage(path: &Path, bytes: &[u8], opts: &InputOptions) -> Result<Ras
         // of its staircase (see `binary`); anti-aliased coverage says where
         // the edge is.
         Ok(if super::binary::is_binary(&cov) {
-            RasterCoverage::Binary { w, h, color, cov }
+            let bits = Bitmap::from_coverage(&cov);
+            RasterCoverage::Binary { w, h, color, bits }
         } else {
             RasterCoverage::Layers {
                 w,
@@ -307,31 +308,44 @@ fn grey_coverage(grey: &image::GrayImage, invert: bool) -> RasterCoverage {
         }
     });
     let raw = grey.as_raw();
+    let raw = raw.get(..w * h).unwrap_or(raw);
+    // One pass over the bytes (in parallel; integer sums, so in any order):
+    // whether every level present has coverage exactly 0 or 1, and the
+    // sum and count of the fully inked pixels' levels.
+    let (binary, sum, n) = raw
+        .par_chunks(1 << 16)
+        .map(|chunk| {
+            let (mut binary, mut sum, mut n) = (true, 0u64, 0u64);
+            for &v in chunk {
+                let c = level[usize::from(v)];
+                binary &= c == 0.0 || c == 1.0;
+                if c > 0.95 {
+                    sum += v as u64;
+                    n += 1;
+                }
+            }
+            (binary, sum, n)
+        })
+        .reduce(|| (true, 0, 0), |a, b| (a.0 && b.0, a.1 + b.1, a.2 + b.2));
+    let color = sum.checked_div(n).map_or(Color::BLACK, |g| {
+        let g = g as u8;
+        Color::rgb(g, g, g)
+    });
+    if binary && raw.len() == w * h {
+        // Straight to the ink bitmap: no coverage grid in between.
+        let bits = Bitmap::from_rows(w, h, raw, |&v| level[usize::from(v)] >= 0.5);
+        return RasterCoverage::Binary { w, h, color, bits };
+    }
     let cov = Grid::from_vec(w, h, raw.iter().map(|&v| level[usize::from(v)]).collect())
         .unwrap_or_else(|| {
             Grid::from_fn(w, h, |x, y| {
                 raw.get(y * w + x).map_or(0.0, |&v| level[usize::from(v)])
             })
         });
-    let (mut sum, mut n) = (0u64, 0u64);
-    for (&v, &c) in raw.iter().zip(cov.data()) {
-        if c > 0.95 {
-            sum += v as u64;
-            n += 1;
-        }
-    }
-    let color = sum.checked_div(n).map_or(Color::BLACK, |g| {
-        let g = g as u8;
-        Color::rgb(g, g, g)
-    });
-    if super::binary::is_binary(&cov) {
-        RasterCoverage::Binary { w, h, color, cov }
-    } else {
-        RasterCoverage::Layers {
-            w,
-            h,
-            layers: vec![(color, cov)],
-        }
+    RasterCoverage::Layers {
+        w,
+        h,
+        layers: vec![(color, cov)],
     }
 }
 

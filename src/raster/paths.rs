@@ -15,6 +15,7 @@
 
 use super::{Coverage, Grid};
 use kurbo::Point;
+use rayon::prelude::*;
 
 /// A binary bitmap's ink flags with a one-pixel border of paper, so a
 /// cell's four corners are plain lookups; rows of `width + 2` bytes.
@@ -51,22 +52,26 @@ impl Bitmap {
 
     /// A bitmap from `width`-long rows of `values` (row-major, at least
     /// `width · height` of them; missing ones are paper), ink where
-    /// `ink(value)`.
-    pub fn from_rows<T>(
+    /// `ink(value)`. Rows are filled in parallel.
+    pub fn from_rows<T: Sync>(
         width: usize,
         height: usize,
         values: &[T],
-        ink: impl Fn(&T) -> bool,
+        ink: impl Fn(&T) -> bool + Sync + Send,
     ) -> Self {
         let pw = width + 2;
         let mut flags = vec![0u8; pw * (height + 2)];
         if width > 0 {
-            let rows = values.chunks(width).take(height);
-            for (row, out) in rows.zip(flags.chunks_mut(pw).skip(1)) {
-                for (f, v) in out.iter_mut().skip(1).zip(row) {
-                    *f = u8::from(ink(v));
-                }
-            }
+            let rows = values.par_chunks(width).take(height);
+            flags
+                .par_chunks_mut(pw)
+                .skip(1)
+                .zip(rows)
+                .for_each(|(out, row)| {
+                    for (f, v) in out.iter_mut().skip(1).zip(row) {
+                        *f = u8::from(ink(v));
+                    }
+                });
         }
         Bitmap {
             width,
