@@ -9,6 +9,7 @@ pub mod edt;
 pub mod input;
 pub mod paths;
 pub mod plain;
+mod polygon;
 pub mod scan;
 pub mod sdf;
 
