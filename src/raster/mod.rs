@@ -5,6 +5,7 @@
 pub mod binary;
 pub mod corridor;
 pub mod cull;
+mod decode;
 pub mod edt;
 pub mod input;
 pub mod paths;
