@@ -364,3 +364,77 @@ fn quantized_layers(
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The grey path as first written: a coverage grid, checked for 0/1
+    /// values, then the bitmap of its ink; the mean level of pixels with
+    /// coverage above 0.95.
+    fn reference(grey: &image::GrayImage, invert: bool) -> (bool, Color, Coverage) {
+        let cov = Grid::from_fn(grey.width() as usize, grey.height() as usize, |x, y| {
+            let g = grey.get_pixel(x as u32, y as u32)[0];
+            let c = 1.0 - luma(&[g, g, g, 255]);
+            if invert {
+                1.0 - c
+            } else {
+                c
+            }
+        });
+        let (mut sum, mut n) = (0u64, 0u64);
+        for (p, &c) in grey.pixels().zip(cov.data()) {
+            if c > 0.95 {
+                sum += p[0] as u64;
+                n += 1;
+            }
+        }
+        let color = sum.checked_div(n).map_or(Color::BLACK, |g| {
+            let g = g as u8;
+            Color::rgb(g, g, g)
+        });
+        (super::super::binary::is_binary(&cov), color, cov)
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+
+        /// Straight from the bytes: the same binary verdict, ink, colour
+        /// and (otherwise) coverage as through the coverage grid.
+        #[test]
+        fn grey_bytes_read_as_through_coverage(
+            w in 1u32..40,
+            h in 1u32..30,
+            levels in prop::collection::vec(any::<u8>(), 1..4),
+            binary in any::<bool>(),
+            invert in any::<bool>(),
+            seed in any::<u64>(),
+        ) {
+            let grey = image::GrayImage::from_fn(w, h, |x, y| {
+                let k = (seed ^ (x as u64 * 31 + y as u64 * 1009)).wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 60;
+                if binary {
+                    image::Luma([if k.is_multiple_of(2) { 0 } else { 255 }])
+                } else {
+                    image::Luma([levels[k as usize % levels.len()]])
+                }
+            });
+            let (is_bin, color, cov) = reference(&grey, invert);
+            match grey_coverage(&grey, invert) {
+                RasterCoverage::Binary { w: bw, h: bh, color: c, bits } => {
+                    prop_assert!(is_bin);
+                    prop_assert_eq!((bw, bh), (w as usize, h as usize));
+                    prop_assert_eq!(c, color);
+                    let ink = bits.to_coverage();
+                    prop_assert_eq!(ink.data(), cov.data());
+                }
+                RasterCoverage::Layers { layers, .. } => {
+                    prop_assert!(!is_bin);
+                    prop_assert_eq!(layers.len(), 1);
+                    prop_assert_eq!(layers[0].0, color);
+                    prop_assert_eq!(layers[0].1.data(), cov.data());
+                }
+            }
+        }
+    }
+}
