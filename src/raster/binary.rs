@@ -428,14 +428,13 @@ fn smooth_tangents(l: &mut SmoothLoop) {
     if n < 3 {
         return;
     }
-    let mut cum = Vec::with_capacity(n + 1);
-    let mut s = 0.0;
-    cum.push(0.0);
-    for i in 0..n {
-        s += (l.points[(i + 1) % n] - l.points[i]).hypot();
-        cum.push(s);
-    }
-    let total = s;
+    // seg[k]: the length of the segment from point k to k + 1, computed
+    // once (walking back over it gives the same number: only the signs of
+    // the difference's components change).
+    let seg: Vec<f64> = (0..n)
+        .map(|k| (l.points[adjacent(k, true, n)] - l.points[k]).hypot())
+        .collect();
+    let total = seg.iter().fold(0.0, |s, &g| s + g);
     let is_corner = corner_mask(l);
     let reach = TANGENT_REACH.min(total / 4.0);
     // Walks from i along the loop (dir = ±1) up to `reach` px or a corner.
@@ -444,7 +443,7 @@ fn smooth_tangents(l: &mut SmoothLoop) {
         let mut d = 0.0;
         loop {
             let k = adjacent(j, forward, n);
-            let step = (l.points[k] - l.points[j]).hypot();
+            let step = if forward { seg[j] } else { seg[k] };
             if d + step >= reach {
                 let f = if step > 0.0 { (reach - d) / step } else { 0.0 };
                 return l.points[j].lerp(l.points[k], f);
