@@ -6,7 +6,7 @@
 //! cargo run --release --example trace_phases [-- FILE.png [RUNS]]
 //! ```
 
-use flourish::raster::{binary, corridor::Corridor, input, Grid};
+use flourish::raster::{binary, corridor::Corridor, input, paths, Grid};
 use flourish::trace::{self, TraceOptions};
 use std::time::Instant;
 
@@ -53,8 +53,8 @@ fn main() {
             .collect(),
     )
     .expect("sizes");
-    let values = cov.map(|c| if c >= 0.5 { -0.5f32 } else { 0.5 });
-    let (t_extract, _) = time(runs, || flourish::trace::contour::extract(&values));
+    let bits = paths::Bitmap::from_coverage(&cov);
+    let (t_extract, _) = time(runs, || paths::paths(&bits));
     let (t_loops, loops) = time(runs, || binary::smooth_loops(&cov));
     let (t_corr, corr) = time(runs, || Corridor::new(&cov));
     let opts = TraceOptions::default();
@@ -90,7 +90,7 @@ fn main() {
         }
     }
     println!(
-        "decode {t_decode:.1} ms, extract {t_extract:.1} ms, smooth_loops {t_loops:.1} ms, corridor {t_corr:.1} ms, fit {t_fit:.1} ms (fastest {fit_min:.1}), trace_file {t_all:.1} ms ({} loops)",
+        "decode {t_decode:.1} ms, paths {t_extract:.1} ms, smooth_loops {t_loops:.1} ms, corridor {t_corr:.1} ms, fit {t_fit:.1} ms (fastest {fit_min:.1}), trace_file {t_all:.1} ms ({} loops)",
         loops.len()
     );
 }

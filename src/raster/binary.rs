@@ -8,8 +8,9 @@
 //! the staircase is replaced by the simplest curve consistent with it:
 //!
 //! 1. **Paths.** The boundary of the ink as closed loops through the
-//!    midpoints of the pixel edges (marching squares on the ±½ field, ties
-//!    joining the ink as everywhere in flourish).
+//!    midpoints of the pixel edges (the loops of marching squares on the
+//!    ±½ field, ties joining the ink as everywhere in flourish), walked on
+//!    the bits ([`paths`]).
 //! 2. **Straight runs.** For every vertex `i`, the furthest vertex `j` such
 //!    that the segment `i → j` passes within [`STRAIGHT_TOLERANCE`] of every
 //!    vertex between them and every step advances along it (a cone of
@@ -20,7 +21,8 @@
 //!    steps 4–5 and the curve fitter downstream make up most of that.
 //! 3. **Optimal polygon.** The fewest such segments around the loop: a
 //!    greedy jump to the furthest straight vertex is optimal from a given
-//!    start, and several starts are tried.
+//!    start, and several starts are tried. (Steps 2–3 live in the private
+//!    module `raster::polygon`.)
 //! 4. **Vertex adjustment.** Each polygon vertex moves to the intersection
 //!    of the least-squares lines of its two edges' path vertices (their
 //!    interior ones: the ends chamfer the corner), kept within half a pixel
@@ -47,6 +49,8 @@
 //! inside of pixel centres taken from the curves (not from the bitmap), so
 //! the sign and the distance agree.
 
+use crate::raster::paths::{self, Bitmap};
+use crate::raster::polygon::{optimal_polygon, Runs};
 use crate::raster::{line_ends, Coverage, Grid, Sdf};
 use crate::trace::contour;
 use kurbo::{CubicBez, ParamCurve, ParamCurveDeriv, Point, Vec2};
@@ -61,9 +65,6 @@ pub const ALPHA_MAX: f64 = 1.0;
 
 /// Flattening tolerance (px) of the smoothed curves.
 const FLATTEN: f64 = 0.02;
-
-/// Longest straight run considered, in path vertices.
-const MAX_RUN: usize = 400;
 
 /// True when every coverage value is exactly 0 or 1.
 pub fn is_binary(cov: &Coverage) -> bool {
@@ -88,20 +89,23 @@ pub struct SmoothLoop {
 /// The smoothed outline of binary coverage `cov` as [`SmoothLoop`]s with
 /// tangents and corners: what `flourish trace` fits Béziers to directly.
 /// Outer loops are counter-clockwise in the y-down sense of
-/// [`contour::Contour::signed_area`] > 0, holes the other way.
+/// [`crate::trace::contour::Contour::signed_area`] > 0, holes the other way.
 pub fn smooth_loops(cov: &Coverage) -> Vec<SmoothLoop> {
-    let values = cov.map(|c| if c >= 0.5 { -0.5 } else { 0.5 });
-    let contours = contour::extract(&values);
-    contours
+    bitmap_loops(&Bitmap::from_coverage(cov))
+}
+
+/// [`smooth_loops`] of a bitmap's ink.
+pub fn bitmap_loops(bits: &Bitmap) -> Vec<SmoothLoop> {
+    paths::paths(bits)
         .par_iter()
-        .map(|c| smooth_loop(&c.points))
+        .map(|p| smooth_loop(p))
         .filter(|l| l.points.len() >= 3)
         .collect()
 }
 
 /// The smoothed outline of binary coverage `cov`: closed polylines in pixel
 /// coordinates (outer loops counter-clockwise in the y-down sense of
-/// [`contour::Contour::signed_area`] > 0, holes the other way).
+/// [`crate::trace::contour::Contour::signed_area`] > 0, holes the other way).
 pub fn smooth_outline(cov: &Coverage) -> Vec<Vec<Point>> {
     smooth_loops(cov).into_iter().map(|l| l.points).collect()
 }
@@ -153,263 +157,6 @@ fn unit(v: Vec2) -> Vec2 {
     } else {
         Vec2::new(1.0, 0.0)
     }
-}
-
-/// Step 2: `lon[i]` = how many vertices ahead of `i` a straight run from `i`
-/// reaches (at least 1).
-///
-/// The path's steps come in few directions, and long stretches repeat one
-/// (a pixel edge, a 45° staircase of edge midpoints). Along such a stretch
-/// every test below is settled by its two ends: a point's distance to a
-/// line is affine along a straight stretch, the cone of admissible
-/// directions is an angular interval, and a stretch that advances keeps
-/// advancing. So the walk jumps from stretch end to stretch end and only
-/// steps vertex by vertex through the stretch where the run ends. The
-/// result is the same as [`run_from`] applied at every vertex (tested).
-#[cfg(test)]
-fn straight_runs(path: &[Point]) -> Vec<usize> {
-    let runs = Runs::new(path);
-    (0..path.len())
-        .into_par_iter()
-        .map(|i| runs.from(i))
-        .collect()
-}
-
-/// What the straight-run walk needs of a path, computed once: its steps and
-/// how far each step repeats. [`Runs::from`] is then one vertex's run, so
-/// the polygon search (step 3) computes runs only at the vertices it visits.
-struct Runs<'a> {
-    path: &'a [Point],
-    steps: Vec<(Vec2, f64)>,
-    /// `stretch[k]`: how many vertices ahead of `k` the step into `k + 1`
-    /// keeps repeating (at least 1).
-    stretch: Vec<usize>,
-}
-
-impl<'a> Runs<'a> {
-    fn new(path: &'a [Point]) -> Self {
-        let n = path.len();
-        let steps = path_steps(path);
-        let mut stretch = vec![1usize; n];
-        if n >= 3 {
-            let same = |k: usize| steps[(k + 1) % n].0 == steps[k].0;
-            // Walk backwards twice around the loop so the wrap is settled.
-            let mut len_after = vec![0usize; n]; // repeats of step k+1 after it
-            for pass in 0..2 {
-                for k in (0..n).rev() {
-                    let next = (k + 1) % n;
-                    let v = if same(next) {
-                        (len_after[next] + 1).min(n - 1)
-                    } else {
-                        0
-                    };
-                    if pass == 1 || v > len_after[k] {
-                        len_after[k] = v;
-                    }
-                }
-            }
-            for k in 0..n {
-                stretch[k] = len_after[k] + 1;
-            }
-        }
-        Runs {
-            path,
-            steps,
-            stretch,
-        }
-    }
-
-    /// `lon[i]`: how many vertices ahead of `i` the straight run from `i`
-    /// reaches (at least 1).
-    fn from(&self, i: usize) -> usize {
-        let (path, steps, stretch) = (self.path, &self.steps, &self.stretch);
-        let n = path.len();
-        let limit = n.min(MAX_RUN);
-        let mut run = Run::new(path[i]);
-        let mut j = i;
-        let mut m = 0usize;
-        loop {
-            let ahead = stretch[j];
-            let e = (j + ahead) % n;
-            if ahead >= 2 && m + ahead < limit {
-                // The stretch's first step must advance, and its end must
-                // pass; then every vertex between passes too.
-                let first = (j + 1) % n;
-                if !run.advances(path[first], steps[first]) {
-                    break;
-                }
-                if run.admits(path[e]) {
-                    m += ahead;
-                    j = e;
-                    if !run.take(path[e]) {
-                        break;
-                    }
-                    continue;
-                }
-            }
-            // Vertex by vertex to the end of the stretch (or the cap).
-            let mut ended = false;
-            for _ in 0..ahead {
-                if m + 1 >= limit {
-                    ended = true;
-                    break;
-                }
-                let k = (j + 1) % n;
-                if !(run.advances(path[k], steps[k]) && run.admits(path[k])) {
-                    ended = true;
-                    break;
-                }
-                m += 1;
-                j = k;
-                if !run.take(path[k]) {
-                    ended = true;
-                    break;
-                }
-            }
-            if ended {
-                break;
-            }
-        }
-        m.max(1)
-    }
-}
-
-/// Each step of a closed path (from vertex k − 1 to vertex k) and its
-/// length.
-fn path_steps(path: &[Point]) -> Vec<(Vec2, f64)> {
-    let n = path.len();
-    (0..n)
-        .map(|k| {
-            let d = path[k] - path[(k + n - 1) % n];
-            (d, d.hypot())
-        })
-        .collect()
-}
-
-/// The state of one straight run from an anchor vertex.
-struct Run {
-    anchor: Point,
-    /// The cone of admissible directions, as its right and left edge
-    /// vectors (counter-clockwise from right to left); None = any.
-    cone: Option<(Vec2, Vec2)>,
-    /// The farthest distance from the anchor of a vertex taken so far.
-    farthest: f64,
-}
-
-impl Run {
-    fn new(anchor: Point) -> Self {
-        Run {
-            anchor,
-            cone: None,
-            farthest: 0.0,
-        }
-    }
-
-    /// Every step must advance along the run: a step across it (the end
-    /// cap of a line, a notch) ends the run, or runs would cut such corners
-    /// while staying within tolerance of every vertex.
-    fn advances(&self, q: Point, (step, step_len): (Vec2, f64)) -> bool {
-        let d = q - self.anchor;
-        let len = d.hypot();
-        len == 0.0 || step.dot(d) > 0.1 * len * step_len
-    }
-
-    /// Whether the segment from the anchor to `q` is a straight run over
-    /// the vertices taken so far: it reaches (nearly) as far as every one
-    /// of them, and passes within the tolerance of each (its direction is
-    /// in the cone).
-    fn admits(&self, q: Point) -> bool {
-        let d = q - self.anchor;
-        // len + tol < farthest, without the square root.
-        let reach = self.farthest - STRAIGHT_TOLERANCE;
-        if reach > 0.0 && d.hypot2() < reach * reach {
-            return false;
-        }
-        match self.cone {
-            Some((r, l)) => r.cross(d) >= 0.0 && d.cross(l) >= 0.0,
-            None => true,
-        }
-    }
-
-    /// Takes `q` into the run, narrowing the cone to the directions that
-    /// pass within the tolerance of it; false when nothing is left beyond.
-    fn take(&mut self, q: Point) -> bool {
-        let tol = STRAIGHT_TOLERANCE;
-        let d = q - self.anchor;
-        let len = d.hypot();
-        self.farthest = self.farthest.max(len);
-        if len <= tol {
-            return true;
-        }
-        // The half-angle a of the cone: sin a = tol / len. The edges are
-        // d turned by ±a, scaled by len (only their directions matter):
-        // len·cos a = √(len² − tol²), len·sin a = tol.
-        let c = (len * len - tol * tol).sqrt() / len;
-        let s = tol / len;
-        let right = Vec2::new(d.x * c + d.y * s, -d.x * s + d.y * c);
-        let left = Vec2::new(d.x * c - d.y * s, d.x * s + d.y * c);
-        self.cone = Some(match self.cone {
-            None => (right, left),
-            Some((r, l)) => {
-                let r2 = if r.cross(right) > 0.0 { right } else { r };
-                let l2 = if left.cross(l) > 0.0 { left } else { l };
-                if r2.cross(l2) < 0.0 {
-                    return false;
-                }
-                (r2, l2)
-            }
-        });
-        true
-    }
-}
-
-/// [`straight_runs`] at one vertex, vertex by vertex: the reference the
-/// stretch-jumping walk must agree with.
-#[cfg(test)]
-fn run_from(path: &[Point], i: usize) -> usize {
-    let n = path.len();
-    let steps = path_steps(path);
-    let mut run = Run::new(path[i]);
-    let mut best = 1;
-    for m in 1..n.min(MAX_RUN) {
-        let k = (i + m) % n;
-        if !(run.advances(path[k], steps[k]) && run.admits(path[k])) {
-            break;
-        }
-        best = m;
-        if !run.take(path[k]) {
-            break;
-        }
-    }
-    best
-}
-
-/// Step 3: the polygon with fewest straight edges, as path indices in order.
-fn optimal_polygon(mut lon: impl FnMut(usize) -> usize, n: usize) -> Vec<usize> {
-    let mut cover = |start: usize| -> Vec<usize> {
-        let mut out = vec![start];
-        let mut at = 0usize; // steps from start
-        while at < n {
-            let i = (start + at) % n;
-            let step = lon(i).max(1);
-            at += step;
-            if at >= n {
-                break;
-            }
-            out.push((start + at) % n);
-        }
-        out
-    };
-    let tries = n.min(32);
-    let mut best: Option<Vec<usize>> = None;
-    for k in 0..tries {
-        let start = k * n / tries;
-        let poly = cover(start);
-        if best.as_ref().is_none_or(|b| poly.len() < b.len()) {
-            best = Some(poly);
-        }
-    }
-    best.unwrap_or_default()
 }
 
 /// The least-squares line (centroid, unit direction from the edge's start
@@ -735,14 +482,13 @@ fn smooth_tangents(l: &mut SmoothLoop) {
     if n < 3 {
         return;
     }
-    let mut cum = Vec::with_capacity(n + 1);
-    let mut s = 0.0;
-    cum.push(0.0);
-    for i in 0..n {
-        s += (l.points[(i + 1) % n] - l.points[i]).hypot();
-        cum.push(s);
-    }
-    let total = s;
+    // seg[k]: the length of the segment from point k to k + 1, computed
+    // once (walking back over it gives the same number: only the signs of
+    // the difference's components change).
+    let seg: Vec<f64> = (0..n)
+        .map(|k| (l.points[adjacent(k, true, n)] - l.points[k]).hypot())
+        .collect();
+    let total = seg.iter().fold(0.0, |s, &g| s + g);
     let is_corner = corner_mask(l);
     let reach = TANGENT_REACH.min(total / 4.0);
     // Walks from i along the loop (dir = ±1) up to `reach` px or a corner.
@@ -751,7 +497,7 @@ fn smooth_tangents(l: &mut SmoothLoop) {
         let mut d = 0.0;
         loop {
             let k = adjacent(j, forward, n);
-            let step = (l.points[k] - l.points[j]).hypot();
+            let step = if forward { seg[j] } else { seg[k] };
             if d + step >= reach {
                 let f = if step > 0.0 { (reach - d) / step } else { 0.0 };
                 return l.points[j].lerp(l.points[k], f);
@@ -782,7 +528,7 @@ fn smooth_tangents(l: &mut SmoothLoop) {
 }
 
 /// Longest edge (px) that can be the end of a thin line.
-pub(super) const LINE_END_EDGE: f64 = 1.5;
+const LINE_END_EDGE: f64 = 1.5;
 
 /// Whether polygon vertex `p` (between `a` and `b`) is a corner of a thin
 /// line's end: one of its edges at most [`LINE_END_EDGE`] long and the
@@ -825,8 +571,13 @@ fn cubic_steps(c: &CubicBez) -> usize {
 /// The SDF of binary coverage read as its smoothed outline: distances to
 /// the curves of [`smooth_outline`], inside taken from the same curves.
 pub fn sdf(cov: &Coverage, to_user: kurbo::Affine) -> Sdf {
-    let loops = smooth_outline(cov);
-    let inside = inside(cov.width(), cov.height(), &loops);
+    bitmap_sdf(&Bitmap::from_coverage(cov), to_user)
+}
+
+/// [`sdf`] of a bitmap's ink.
+pub fn bitmap_sdf(bits: &Bitmap, to_user: kurbo::Affine) -> Sdf {
+    let loops: Vec<Vec<Point>> = bitmap_loops(bits).into_iter().map(|l| l.points).collect();
+    let inside = inside(bits.width(), bits.height(), &loops);
     let mut segments = Vec::new();
     for poly in &loops {
         let n = poly.len();
@@ -905,101 +656,6 @@ mod tests {
         for y in 0..40 {
             for x in 0..40 {
                 assert_eq!(ins.get(x, y), cov.get(x, y) == 1.0, "{x},{y}");
-            }
-        }
-    }
-
-    /// The stretch-jumping walk gives the vertex-by-vertex runs exactly,
-    /// on the loops of random blobs (every kind of staircase and corner).
-    #[test]
-    fn jumping_runs_equal_the_vertex_by_vertex_reference() {
-        let mut seed = 0x9e3779b97f4a7c15u64;
-        let mut rnd = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
-        let mut checked = 0;
-        for _ in 0..40 {
-            // A union of random discs and slanted bars, rasterized.
-            let shapes: Vec<(f64, f64, f64, f64)> = (0..4)
-                .map(|_| (rnd() * 60.0, rnd() * 60.0, 3.0 + rnd() * 15.0, rnd()))
-                .collect();
-            let cov = Grid::from_fn(64, 64, |x, y| {
-                let (x, y) = (x as f64 + 0.5, y as f64 + 0.5);
-                let hit = shapes.iter().any(|&(cx, cy, r, k)| {
-                    if k < 0.5 {
-                        (x - cx).hypot(y - cy) <= r
-                    } else {
-                        let slope = 4.0 * k - 3.0;
-                        ((y - cy) - slope * (x - cx)).abs() < 0.3 * r && (x - cx).abs() < 2.0 * r
-                    }
-                });
-                if hit {
-                    1.0
-                } else {
-                    0.0
-                }
-            });
-            let values = cov.map(|c| if c >= 0.5 { -0.5 } else { 0.5 });
-            for c in contour::extract(&values) {
-                let path = &c.points;
-                let fast = straight_runs(path);
-                for (i, &lon) in fast.iter().enumerate() {
-                    assert_eq!(lon, run_from(path, i), "vertex {i} of {}", path.len());
-                    checked += 1;
-                }
-            }
-        }
-        assert!(checked > 5000, "only {checked} vertices");
-    }
-
-    #[test]
-    fn straight_runs_follow_a_shallow_staircase() {
-        // A band of slope 1/5 rasterized: its long edges are staircases of
-        // five-pixel steps. Runs are anchored at a vertex that may itself be
-        // half a pixel off the drawn edge, so they span a couple of steps,
-        // not the whole edge (see the module docs).
-        let cov = Grid::from_fn(90, 40, |x, y| {
-            let (x, y) = (x as f64 + 0.5, y as f64 + 0.5);
-            let c = 10.3 + x / 5.0;
-            if (y - c).abs() < 4.0 && (5.0..85.0).contains(&x) {
-                1.0
-            } else {
-                0.0
-            }
-        });
-        let values = cov.map(|c| if c >= 0.5 { -0.5 } else { 0.5 });
-        let cs = contour::extract(&values);
-        assert_eq!(cs.len(), 1);
-        let path = &cs[0].points;
-        let n = path.len();
-        let lon = straight_runs(path);
-        for (i, &m) in lon.iter().enumerate() {
-            assert_eq!(m, run_from(path, i));
-        }
-        let longest = lon.iter().copied().max().unwrap_or(0);
-        assert!(longest >= 8, "longest run {longest} of {n}");
-        // Straight means: every vertex within the tolerance of the chord.
-        for (i, &m) in lon.iter().enumerate() {
-            let chord = kurbo::Line::new(path[i], path[(i + m) % n]);
-            for k in 0..=m {
-                let d = crate::raster::sdf::point_segment_distance(path[(i + k) % n], chord);
-                assert!(d <= STRAIGHT_TOLERANCE + 1e-9, "run {i}+{m}: {d}");
-            }
-        }
-        // The polygon needs far fewer vertices than the path.
-        let poly = optimal_polygon(|i| lon[i], n);
-        assert!(poly.len() * 5 <= n, "{} vertices of {n}", poly.len());
-        // And the smoothed outline stays within half a pixel (plus the
-        // rounding of the band's four corners) of the drawn band's edges.
-        let loops = smooth_outline(&cov);
-        assert_eq!(loops.len(), 1);
-        for p in &loops[0] {
-            if (6.0..84.0).contains(&p.x) {
-                let off = ((p.y - 10.3 - p.x / 5.0).abs() - 4.0).abs();
-                assert!(off < 0.6, "{p:?} is {off} px off the band's edge");
             }
         }
     }

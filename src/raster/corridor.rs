@@ -15,6 +15,7 @@
 //! outlines ([`crate::trace::cover`]): a curve point is acceptable when a
 //! mixed cell lies within the tolerance of it.
 
+use super::paths::Bitmap;
 use super::{Coverage, Grid};
 use kurbo::Point;
 
@@ -35,22 +36,17 @@ impl Corridor {
 
     /// The corridor of binary coverage `cov` (ink where coverage ≥ ½).
     pub fn new(cov: &Coverage) -> Self {
-        let (w, h) = (cov.width(), cov.height());
-        // Ink flags with a border of paper: padded (x + 1, y + 1) is pixel
-        // (x, y), so cell (ci, cj) has the padded corners (ci, cj) to
-        // (ci + 1, cj + 1).
-        let pw = w + 2;
-        let mut ink = vec![false; pw * (h + 2)];
-        if w > 0 {
-            for (y, row) in cov.data().chunks(w).enumerate() {
-                let start = (y + 1) * pw + 1;
-                for (flag, &c) in ink[start..start + row.len()].iter_mut().zip(row) {
-                    *flag = c >= 0.5;
-                }
-            }
-        }
+        Self::from_bitmap(&Bitmap::from_coverage(cov))
+    }
+
+    /// The corridor of a bitmap's ink.
+    pub fn from_bitmap(bits: &Bitmap) -> Self {
+        let (w, h) = (bits.width(), bits.height());
+        // Padded row y + 1 holds pixel row y between two paper flags, so
+        // cell (ci, cj) has the padded corners (ci, cj) to (ci + 1, cj + 1).
         let mut mixed = Vec::with_capacity((w + 1) * (h + 1));
-        for (top, bottom) in ink.chunks(pw).zip(ink.chunks(pw).skip(1)) {
+        let rows = bits.padded_rows();
+        for (top, bottom) in rows.clone().zip(rows.skip(1)) {
             for (t, b) in top.windows(2).zip(bottom.windows(2)) {
                 let a = t[0];
                 mixed.push(a != t[1] || a != b[0] || a != b[1]);

@@ -13,7 +13,9 @@
 //! (raster) is its own layer; layers are stacked bottom to top and each one
 //! extends under the layers above it, so stacked fills leave no seams.
 
-use super::{Coverage, Grid, Sdf};
+pub use super::decode::decode_raster;
+use super::decode::{raster_coverage, RasterCoverage};
+use super::{Grid, Sdf};
 use crate::error::{Error, Result};
 use crate::io;
 use crate::svg_out::Color;
@@ -84,34 +86,6 @@ pub fn looks_like_svg(bytes: &[u8]) -> bool {
     t.starts_with('<') || bytes.starts_with(&[0x1f, 0x8b])
 }
 
-/// Decodes raster bytes, refusing oversized images before decoding.
-pub fn decode_raster(path: &Path, bytes: &[u8]) -> Result<image::DynamicImage> {
-    let bad = |e: &dyn std::fmt::Display| Error::Image {
-        path: path.to_path_buf(),
-        reason: e.to_string(),
-    };
-    let reader = image::ImageReader::new(std::io::Cursor::new(bytes))
-        .with_guessed_format()
-        .map_err(|e| bad(&e))?;
-    if reader.format().is_none() {
-        return Err(Error::Image {
-            path: path.to_path_buf(),
-            reason: "unknown format (expected PNG, JPEG, BMP, GIF, TIFF, WebP or SVG)".into(),
-        });
-    }
-    let (w, h) = reader.into_dimensions().map_err(|e| bad(&e))?;
-    io::check_canvas(path, w as u64, h as u64)?;
-    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
-        .with_guessed_format()
-        .map_err(|e| bad(&e))?;
-    let mut limits = image::Limits::default();
-    limits.max_image_width = Some(io::MAX_SIDE as u32);
-    limits.max_image_height = Some(io::MAX_SIDE as u32);
-    limits.max_alloc = Some(io::MAX_PIXELS * 8);
-    reader.limits(limits);
-    reader.decode().map_err(|e| bad(&e))
-}
-
 /// What `flourish trace` reads from a file: layers of ink with an SDF each,
 /// or, for a binary bitmap traced as one layer, the smooth outline it stands
 /// for (fitted directly; no SDF is built).
@@ -148,13 +122,20 @@ pub fn load_traceable(path: &Path, opts: &InputOptions) -> Result<Traceable> {
         return load_svg(path, &bytes, opts).map(Traceable::Field);
     }
     match raster_coverage(path, &bytes, opts)? {
-        RasterCoverage::Binary { w, h, color, cov } => Ok(Traceable::Outline(OutlineInk {
-            width: w as f64,
-            height: h as f64,
-            color,
-            loops: super::binary::smooth_loops(&cov),
-            corridor: Some(super::corridor::Corridor::new(&cov)),
-        })),
+        RasterCoverage::Binary { w, h, color, bits } => {
+            // The corridor is built while the loops are smoothed.
+            let (loops, corridor) = rayon::join(
+                || super::binary::bitmap_loops(&bits),
+                || super::corridor::Corridor::from_bitmap(&bits),
+            );
+            Ok(Traceable::Outline(OutlineInk {
+                width: w as f64,
+                height: h as f64,
+                color,
+                loops,
+                corridor: Some(corridor),
+            }))
+        }
         // One anti-aliased layer: its sub-pixel outline, fitted directly.
         RasterCoverage::Layers { w, h, layers } if layers.len() == 1 && !opts.layers => {
             let (color, cov) = &layers[0];
@@ -174,315 +155,9 @@ pub fn load_traceable(path: &Path, opts: &InputOptions) -> Result<Traceable> {
     }
 }
 
-/// A decoded raster's ink coverage, before any SDF is built.
-enum RasterCoverage {
-    /// One layer of exactly 0/1 coverage.
-    Binary {
-        w: usize,
-        h: usize,
-        color: Color,
-        cov: Coverage,
-    },
-    /// Layers (bottom first) of fractional coverage.
-    Layers {
-        w: usize,
-        h: usize,
-        layers: Vec<(Color, Coverage)>,
-    },
-}
-
-impl RasterCoverage {
-    /// Each layer's SDF: a binary layer's from its smooth outline, others
-    /// from their anti-aliased coverage.
-    fn into_ink(self) -> Ink {
-        let to_user = Affine::IDENTITY;
-        let (w, h, layers) = match self {
-            RasterCoverage::Binary { w, h, color, cov } => (
-                w,
-                h,
-                vec![InkLayer {
-                    color,
-                    sdf: super::binary::sdf(&cov, to_user),
-                }],
-            ),
-            RasterCoverage::Layers { w, h, layers } => (
-                w,
-                h,
-                layers
-                    .into_iter()
-                    .map(|(color, cov)| InkLayer {
-                        color,
-                        sdf: Sdf::from_coverage(&cov, to_user),
-                    })
-                    .collect(),
-            ),
-        };
-        Ink {
-            width: w as f64,
-            height: h as f64,
-            layers,
-        }
-    }
-}
-
 /// Raster bytes (PNG, JPEG, …) read from `path` as ink, as [`load`] reads them.
 pub fn load_raster(path: &Path, bytes: &[u8], opts: &InputOptions) -> Result<Ink> {
     Ok(raster_coverage(path, bytes, opts)?.into_ink())
-}
-
-/// Decodes raster bytes into ink coverage: alpha or darkness, one layer or
-/// quantized colour layers.
-fn raster_coverage(path: &Path, bytes: &[u8], opts: &InputOptions) -> Result<RasterCoverage> {
-    let img = decode_raster(path, bytes)?;
-    if let (image::DynamicImage::ImageLuma8(grey), false) = (&img, opts.layers) {
-        return Ok(grey_coverage(grey, opts.invert));
-    }
-    let img = img.to_rgba8();
-    let (w, h) = (img.width() as usize, img.height() as usize);
-    let has_alpha = img.pixels().any(|p| p[3] < 255);
-    let px: Vec<[u8; 4]> = img.pixels().map(|p| p.0).collect();
-    if opts.layers {
-        Ok(RasterCoverage::Layers {
-            w,
-            h,
-            layers: quantized_layers(&px, w, h, has_alpha, opts.invert),
-        })
-    } else {
-        let cov = Grid::from_vec(
-            w,
-            h,
-            px.iter()
-                .map(|p| {
-                    let c = if has_alpha {
-                        p[3] as f32 / 255.0
-                    } else {
-                        1.0 - luma(p)
-                    };
-                    if opts.invert {
-                        1.0 - c
-                    } else {
-                        c
-                    }
-                })
-                .collect(),
-        )
-        .expect("sizes match");
-        let color = mean_ink_colour(&px, &cov);
-        // A binary bitmap stands for a smooth outline within half a pixel
-        // of its staircase (see `binary`); anti-aliased coverage says where
-        // the edge is.
-        Ok(if super::binary::is_binary(&cov) {
-            RasterCoverage::Binary { w, h, color, cov }
-        } else {
-            RasterCoverage::Layers {
-                w,
-                h,
-                layers: vec![(color, cov)],
-            }
-        })
-    }
-}
-
-/// [`raster_coverage`] of an 8-bit grey image without a colour copy: the
-/// same coverage (darkness through [`luma`], so byte for byte what the RGBA
-/// path gives) and the same mean ink colour, grey.
-fn grey_coverage(grey: &image::GrayImage, invert: bool) -> RasterCoverage {
-    let (w, h) = (grey.width() as usize, grey.height() as usize);
-    // Coverage of each of the 256 grey levels, computed once.
-    let level: [f32; 256] = std::array::from_fn(|v| {
-        let g = v as u8;
-        let c = 1.0 - luma(&[g, g, g, 255]);
-        if invert {
-            1.0 - c
-        } else {
-            c
-        }
-    });
-    let raw = grey.as_raw();
-    let cov = Grid::from_vec(w, h, raw.iter().map(|&v| level[usize::from(v)]).collect())
-        .unwrap_or_else(|| {
-            Grid::from_fn(w, h, |x, y| {
-                raw.get(y * w + x).map_or(0.0, |&v| level[usize::from(v)])
-            })
-        });
-    let (mut sum, mut n) = (0u64, 0u64);
-    for (&v, &c) in raw.iter().zip(cov.data()) {
-        if c > 0.95 {
-            sum += v as u64;
-            n += 1;
-        }
-    }
-    let color = sum.checked_div(n).map_or(Color::BLACK, |g| {
-        let g = g as u8;
-        Color::rgb(g, g, g)
-    });
-    if super::binary::is_binary(&cov) {
-        RasterCoverage::Binary { w, h, color, cov }
-    } else {
-        RasterCoverage::Layers {
-            w,
-            h,
-            layers: vec![(color, cov)],
-        }
-    }
-}
-
-fn luma(p: &[u8; 4]) -> f32 {
-    (0.2126 * p[0] as f32 + 0.7152 * p[1] as f32 + 0.0722 * p[2] as f32) / 255.0
-}
-
-/// The mean colour of fully inked pixels, black when there are none.
-fn mean_ink_colour(px: &[[u8; 4]], cov: &Coverage) -> Color {
-    let mut sum = [0u64; 3];
-    let mut n = 0u64;
-    for (p, &c) in px.iter().zip(cov.data()) {
-        if c > 0.95 {
-            for k in 0..3 {
-                sum[k] += p[k] as u64;
-            }
-            n += 1;
-        }
-    }
-    if n == 0 {
-        return Color::BLACK;
-    }
-    Color::rgb((sum[0] / n) as u8, (sum[1] / n) as u8, (sum[2] / n) as u8)
-}
-
-/// Splits a colour raster into stacked layers: a palette of dominant colours
-/// (the paper colour, most common on the border, excluded), each pixel
-/// explained as a mix of its two nearest palette colours (anti-aliasing),
-/// and layer `k` covering its own colour and every colour stacked above it.
-fn quantized_layers(
-    px: &[[u8; 4]],
-    w: usize,
-    h: usize,
-    has_alpha: bool,
-    invert: bool,
-) -> Vec<(Color, Coverage)> {
-    // Composite over white so transparency reads as paper.
-    let rgb: Vec<[f32; 3]> = px
-        .iter()
-        .map(|p| {
-            let a = if has_alpha { p[3] as f32 / 255.0 } else { 1.0 };
-            [0, 1, 2].map(|k| p[k] as f32 * a + 255.0 * (1.0 - a))
-        })
-        .collect();
-    let key =
-        |c: &[f32; 3]| ((c[0] as u32 >> 4) << 8) | ((c[1] as u32 >> 4) << 4) | (c[2] as u32 >> 4);
-    let mut hist = std::collections::BTreeMap::<u32, (u64, [f64; 3])>::new();
-    for c in &rgb {
-        let e = hist.entry(key(c)).or_insert((0, [0.0; 3]));
-        e.0 += 1;
-        for (sum, &v) in e.1.iter_mut().zip(c) {
-            *sum += v as f64;
-        }
-    }
-    let mut bins: Vec<(u64, [f32; 3])> = hist
-        .values()
-        .map(|(n, s)| (*n, [0, 1, 2].map(|k| (s[k] / *n as f64) as f32)))
-        .collect();
-    bins.sort_by(|a, b| {
-        b.0.cmp(&a.0)
-            .then(a.1.partial_cmp(&b.1).unwrap_or(std::cmp::Ordering::Equal))
-    });
-    let min_count = ((w * h) as u64 / 500).max(1);
-    let dist2 = |a: &[f32; 3], b: &[f32; 3]| (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f32>();
-    let mut palette: Vec<[f32; 3]> = Vec::new();
-    for (n, c) in &bins {
-        if *n < min_count || palette.len() >= 8 {
-            break;
-        }
-        if palette.iter().all(|p| dist2(p, c) > 48.0 * 48.0) {
-            palette.push(*c);
-        }
-    }
-    // Paper: the most common colour on the border (white if none).
-    let mut border = std::collections::BTreeMap::<u32, usize>::new();
-    for (i, c) in rgb.iter().enumerate() {
-        let (x, y) = (i % w, i / w);
-        if x == 0 || y == 0 || x + 1 == w || y + 1 == h {
-            *border.entry(key(c)).or_default() += 1;
-        }
-    }
-    let paper_key = border
-        .iter()
-        .max_by_key(|(k, n)| (**n, std::cmp::Reverse(**k)))
-        .map(|(k, _)| *k);
-    let paper = palette
-        .iter()
-        .position(|p| Some(key(p)) == paper_key)
-        .or_else(|| {
-            palette
-                .iter()
-                .position(|p| dist2(p, &[255.0; 3]) < 48.0 * 48.0)
-        });
-    let paper_colour = paper.map(|i| palette[i]).unwrap_or([255.0; 3]);
-    if let Some(i) = paper {
-        palette.remove(i);
-    }
-    palette.insert(0, paper_colour);
-    if invert {
-        // Inverting swaps the roles: trace the paper as the only layer.
-        palette.truncate(1);
-    }
-    let k = palette.len();
-    // Per pixel, weights of its two nearest palette colours.
-    let mut weights = vec![0f32; w * h * k];
-    for (i, c) in rgb.iter().enumerate() {
-        let mut best = (f32::MAX, 0usize, 0usize, 1.0f32);
-        for a in 0..k {
-            for b in a..k {
-                let (pa, pb) = (&palette[a], &palette[b]);
-                let d = [0, 1, 2].map(|j| pa[j] - pb[j]);
-                let dd: f32 = d.iter().map(|v| v * v).sum();
-                let t = if dd > 0.0 {
-                    (((0..3).map(|j| (c[j] - pb[j]) * d[j]).sum::<f32>()) / dd).clamp(0.0, 1.0)
-                } else {
-                    1.0
-                };
-                let mix = [0, 1, 2].map(|j| pb[j] + t * d[j]);
-                let e = dist2(&mix, c);
-                if e < best.0 {
-                    best = (e, a, b, t);
-                }
-            }
-        }
-        let (_, a, b, t) = best;
-        weights[i * k + a] += t;
-        weights[i * k + b] += 1.0 - t;
-    }
-    if invert {
-        let cov = Grid::from_fn(w, h, |x, y| weights[(y * w + x) * k]);
-        let c = palette[0];
-        return vec![(Color::rgb(c[0] as u8, c[1] as u8, c[2] as u8), cov)];
-    }
-    // Stack by area, largest at the bottom.
-    let mut order: Vec<usize> = (1..k).collect();
-    let area = |j: usize| (0..w * h).map(|i| weights[i * k + j] as f64).sum::<f64>();
-    let areas: Vec<f64> = (0..k).map(area).collect();
-    order.sort_by(|&a, &b| areas[b].total_cmp(&areas[a]).then(a.cmp(&b)));
-    order
-        .iter()
-        .enumerate()
-        .filter(|(_, &j)| areas[j] > 0.0)
-        .map(|(pos, &j)| {
-            let above = &order[pos..];
-            let cov = Grid::from_fn(w, h, |x, y| {
-                let i = y * w + x;
-                above
-                    .iter()
-                    .map(|&m| weights[i * k + m])
-                    .sum::<f32>()
-                    .min(1.0)
-            });
-            let c = palette[j];
-            (
-                Color::rgb(c[0].round() as u8, c[1].round() as u8, c[2].round() as u8),
-                cov,
-            )
-        })
-        .collect()
 }
 
 /// One filled shape of an SVG, in pixel coordinates.

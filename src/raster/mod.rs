@@ -5,10 +5,13 @@
 pub mod binary;
 pub mod corridor;
 pub mod cull;
+mod decode;
 pub mod edt;
 pub mod input;
 mod line_ends;
+pub mod paths;
 pub mod plain;
+mod polygon;
 pub mod scan;
 pub mod sdf;
 

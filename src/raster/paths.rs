@@ -1,0 +1,368 @@
+//! Step 1 of [`crate::raster::binary`]: the closed paths around a binary
+//! bitmap's ink, walked on the bits directly (potrace's path decomposition,
+//! Selinger 2003, §2.1, with flourish's vertices and orientation).
+//!
+//! A path runs through the midpoints of the pixel edges between ink and
+//! paper: exactly the loops of [`crate::trace::contour::extract`] on the
+//! ±½ field of the bitmap (pixel centres as samples, a crossing halfway
+//! along every link, saddles joining the ink), in the same order, from the
+//! same first vertex and in the same direction, so the smoothing
+//! downstream sees the same input (tested against `extract` on random
+//! bitmaps). Instead of marching every cell of the grid into a successor
+//! table and sorting it, each loop is followed from its first link through
+//! the four ink flags of each cell it enters, and the scan for first links
+//! skips runs of eight samples without a change of colour.
+
+use super::{Coverage, Grid};
+use kurbo::Point;
+use rayon::prelude::*;
+
+/// A binary bitmap's ink flags with a one-pixel border of paper, so a
+/// cell's four corners are plain lookups; rows of `width + 2` bytes.
+#[derive(Clone, Debug)]
+pub struct Bitmap {
+    width: usize,
+    height: usize,
+    /// `flags[(y + 1) * (width + 2) + x + 1]`: 1 when pixel (x, y) is ink.
+    flags: Vec<u8>,
+}
+
+impl Bitmap {
+    /// A `width` × `height` bitmap with ink where `ink(x, y)` (pixels).
+    pub fn from_fn(width: usize, height: usize, mut ink: impl FnMut(usize, usize) -> bool) -> Self {
+        let pw = width + 2;
+        let mut flags = vec![0u8; pw * (height + 2)];
+        for (y, row) in flags.chunks_mut(pw).skip(1).take(height).enumerate() {
+            for (x, f) in row.iter_mut().skip(1).take(width).enumerate() {
+                *f = u8::from(ink(x, y));
+            }
+        }
+        Bitmap {
+            width,
+            height,
+            flags,
+        }
+    }
+
+    /// The ink of coverage `cov`: pixels with coverage ≥ ½ (the rule of
+    /// [`crate::raster::binary`] and [`crate::raster::corridor`]).
+    pub fn from_coverage(cov: &Coverage) -> Self {
+        Self::from_rows(cov.width(), cov.height(), cov.data(), |&c| c >= 0.5)
+    }
+
+    /// A bitmap from `width`-long rows of `values` (row-major, at least
+    /// `width · height` of them; missing ones are paper), ink where
+    /// `ink(value)`. Rows are filled in parallel.
+    pub fn from_rows<T: Sync>(
+        width: usize,
+        height: usize,
+        values: &[T],
+        ink: impl Fn(&T) -> bool + Sync + Send,
+    ) -> Self {
+        let pw = width + 2;
+        let mut flags = vec![0u8; pw * (height + 2)];
+        if width > 0 {
+            let rows = values.par_chunks(width).take(height);
+            flags
+                .par_chunks_mut(pw)
+                .skip(1)
+                .zip(rows)
+                .for_each(|(out, row)| {
+                    for (f, v) in out.iter_mut().skip(1).zip(row) {
+                        *f = u8::from(ink(v));
+                    }
+                });
+        }
+        Bitmap {
+            width,
+            height,
+            flags,
+        }
+    }
+
+    /// Width in pixels.
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    /// Height in pixels.
+    pub fn height(&self) -> usize {
+        self.height
+    }
+
+    /// Whether pixel (x, y) is ink; pixels outside the bitmap are paper.
+    pub fn ink(&self, x: isize, y: isize) -> bool {
+        let (w, h) = (self.width as isize, self.height as isize);
+        if x < -1 || y < -1 || x > w || y > h {
+            return false;
+        }
+        let i = (y + 1) as usize * (self.width + 2) + (x + 1) as usize;
+        self.flags.get(i).is_some_and(|&f| f != 0)
+    }
+
+    /// The padded rows (`width + 2` flags each, `height + 2` of them).
+    pub(crate) fn padded_rows(&self) -> std::slice::Chunks<'_, u8> {
+        self.flags.chunks(self.width + 2)
+    }
+
+    /// As coverage: 1 for ink, 0 for paper.
+    pub fn to_coverage(&self) -> Coverage {
+        Grid::from_fn(self.width, self.height, |x, y| {
+            if self.ink(x as isize, y as isize) {
+                1.0
+            } else {
+                0.0
+            }
+        })
+    }
+}
+
+/// A link between two 4-adjacent pixel centres (x, y) and (x + 1, y)
+/// (horizontal) or (x, y + 1) (vertical), as in [`crate::trace::contour`].
+#[derive(Clone, Copy, PartialEq, Eq)]
+struct Link {
+    horizontal: bool,
+    x: i32,
+    y: i32,
+}
+
+impl Link {
+    /// The path vertex on the link: its midpoint, in pixel coordinates
+    /// (pixel centres at half-integers).
+    fn point(self) -> Point {
+        let (x, y) = (self.x as f64 + 0.5, self.y as f64 + 0.5);
+        if self.horizontal {
+            Point::new(x + 0.5, y)
+        } else {
+            Point::new(x, y + 0.5)
+        }
+    }
+
+    /// Edge `e` of cell (x, y) (corners (x, y) to (x + 1, y + 1)), in
+    /// clockwise order (y down): top, right, bottom, left.
+    fn of_cell(x: i32, y: i32, e: u8) -> Link {
+        match e {
+            0 => Link {
+                horizontal: true,
+                x,
+                y,
+            },
+            1 => Link {
+                horizontal: false,
+                x: x + 1,
+                y,
+            },
+            2 => Link {
+                horizontal: true,
+                x,
+                y: y + 1,
+            },
+            _ => Link {
+                horizontal: false,
+                x,
+                y,
+            },
+        }
+    }
+}
+
+/// `PARTNER[case][e]`: in a cell whose corners (top-left, top-right,
+/// bottom-right, bottom-left) are ink as the bits of `case`, the edge where
+/// a path that leaves the ink across edge `e` (clockwise) continues. A
+/// saddle joins the ink (the next edge clockwise); any other cell has one
+/// edge crossed from paper into ink. Entries for edges not crossed from ink
+/// to paper are unused.
+const PARTNER: [[u8; 4]; 16] = partner_table();
+
+const fn partner_table() -> [[u8; 4]; 16] {
+    let mut t = [[0u8; 4]; 16];
+    let mut case = 0;
+    while case < 16 {
+        let mut e = 0;
+        while e < 4 {
+            t[case][e] = if case == 5 || case == 10 {
+                ((e + 1) % 4) as u8
+            } else {
+                let mut p = e;
+                let mut k = 0;
+                while k < 4 {
+                    let from_ink = (case >> k) & 1 == 1;
+                    let to_ink = (case >> ((k + 1) % 4)) & 1 == 1;
+                    if !from_ink && to_ink {
+                        p = k;
+                    }
+                    k += 1;
+                }
+                p as u8
+            };
+            e += 1;
+        }
+        case += 1;
+    }
+    t
+}
+
+/// The closed paths around the ink of `bits` (see the module docs): outer
+/// boundaries with positive signed area
+/// ([`crate::trace::contour::signed_area`]), holes negative; vertices at
+/// the midpoints of pixel edges, in pixel coordinates.
+pub fn paths(bits: &Bitmap) -> Vec<Vec<Point>> {
+    let (w, h) = (bits.width, bits.height);
+    if w == 0 || h == 0 {
+        return Vec::new();
+    }
+    let pw = w + 2;
+    // Horizontal links already on a path: (w + 1) per padded row. Every
+    // loop crosses one, and the first of a loop in row-major order is where
+    // `extract` starts it.
+    let mut seen = vec![false; (w + 1) * (h + 2)];
+    // A loop cannot be longer than there are links.
+    let cap = 2 * (w + 1) * (h + 2) + 2 * w + 2;
+    let mut out = Vec::new();
+    for (yi, row) in bits.padded_rows().enumerate() {
+        let mut xi = 0usize;
+        while xi + 1 < pw {
+            // Eight links at once where nine samples in a row agree.
+            if let Some(s) = row.get(xi..xi + 9) {
+                let word = |s: &[u8]| {
+                    let mut a = [0u8; 8];
+                    a.copy_from_slice(&s[..8]);
+                    u64::from_le_bytes(a)
+                };
+                if word(s) == word(&s[1..]) {
+                    xi += 8;
+                    continue;
+                }
+            }
+            let crossed = row.get(xi) != row.get(xi + 1);
+            let id = yi * (w + 1) + xi;
+            if crossed && !seen.get(id).copied().unwrap_or(true) {
+                let start = Link {
+                    horizontal: true,
+                    x: xi as i32 - 1,
+                    y: yi as i32 - 1,
+                };
+                out.push(walk(bits, start, &mut seen, cap));
+            }
+            xi += 1;
+        }
+    }
+    out
+}
+
+/// Follows the loop through `start` (a crossed horizontal link) until it
+/// closes, marking its horizontal links in `seen`.
+fn walk(bits: &Bitmap, start: Link, seen: &mut [bool], cap: usize) -> Vec<Point> {
+    let w = bits.width;
+    let ink = |x: i32, y: i32| bits.ink(x as isize, y as isize);
+    let mut pts = Vec::new();
+    let mut cur = start;
+    loop {
+        pts.push(cur.point());
+        // The cell in which the path leaves the ink across `cur`
+        // (clockwise), and which of its edges `cur` is.
+        let (cx, cy, e) = if cur.horizontal {
+            if let Some(s) = seen.get_mut((cur.y + 1) as usize * (w + 1) + (cur.x + 1) as usize) {
+                *s = true;
+            }
+            if ink(cur.x, cur.y) {
+                (cur.x, cur.y, 0)
+            } else {
+                (cur.x, cur.y - 1, 2)
+            }
+        } else if ink(cur.x, cur.y) {
+            (cur.x - 1, cur.y, 1)
+        } else {
+            (cur.x, cur.y, 3)
+        };
+        let case = usize::from(ink(cx, cy))
+            | usize::from(ink(cx + 1, cy)) << 1
+            | usize::from(ink(cx + 1, cy + 1)) << 2
+            | usize::from(ink(cx, cy + 1)) << 3;
+        cur = Link::of_cell(cx, cy, PARTNER[case][e]);
+        if cur == start || pts.len() > cap {
+            return pts;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::trace::contour;
+    use proptest::prelude::*;
+
+    /// The reference: marching squares on the ±½ field.
+    fn reference(bits: &Bitmap) -> Vec<Vec<Point>> {
+        let values = Grid::from_fn(bits.width(), bits.height(), |x, y| {
+            if bits.ink(x as isize, y as isize) {
+                -0.5f32
+            } else {
+                0.5
+            }
+        });
+        contour::extract(&values)
+            .into_iter()
+            .map(|c| c.points)
+            .collect()
+    }
+
+    #[test]
+    fn a_square_and_its_hole() {
+        let bits = Bitmap::from_fn(7, 7, |x, y| {
+            (1..6).contains(&x) && (1..6).contains(&y) && (x, y) != (3, 3)
+        });
+        let ps = paths(&bits);
+        assert_eq!(ps, reference(&bits));
+        assert_eq!(ps.len(), 2);
+        assert!((contour::signed_area(&ps[0]) - (25.0 - 0.5)).abs() < 1e-12);
+        assert!((contour::signed_area(&ps[1]) + 0.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn empty_and_full() {
+        assert!(paths(&Bitmap::from_fn(0, 5, |_, _| true)).is_empty());
+        assert!(paths(&Bitmap::from_fn(9, 4, |_, _| false)).is_empty());
+        let full = Bitmap::from_fn(3, 2, |_, _| true);
+        assert_eq!(paths(&full), reference(&full));
+    }
+
+    #[test]
+    fn coverage_round_trip() {
+        let cov = Grid::from_fn(5, 3, |x, y| ((x * 7 + y * 3) % 4) as f32 / 3.0);
+        let bits = Bitmap::from_coverage(&cov);
+        let back = bits.to_coverage();
+        for y in 0..3 {
+            for x in 0..5 {
+                assert_eq!(back.get(x, y), if cov.get(x, y) >= 0.5 { 1.0 } else { 0.0 });
+            }
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(400))]
+
+        /// Same loops, same order, same first vertex, same direction as
+        /// marching squares, on random bitmaps of every density (saddles,
+        /// one-pixel lines, ink on the border, runs longer than a word).
+        #[test]
+        fn paths_equal_marching_squares(
+            w in 1usize..40,
+            h in 1usize..24,
+            density in 0.05f64..0.95,
+            blocky in any::<bool>(),
+            seed in any::<u64>(),
+        ) {
+            let bits = Bitmap::from_fn(w, h, |x, y| {
+                let (x, y) = if blocky { (x / 5, y / 3) } else { (x, y) };
+                let mut z = seed ^ (x as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)
+                    ^ (y as u64).wrapping_mul(0xc2b2_ae3d_27d4_eb4f);
+                z ^= z >> 31;
+                z = z.wrapping_mul(0xbf58_476d_1ce4_e5b9);
+                z ^= z >> 29;
+                ((z >> 11) as f64 / (1u64 << 53) as f64) < density
+            });
+            prop_assert_eq!(paths(&bits), reference(&bits));
+        }
+    }
+}
