@@ -141,7 +141,7 @@ const NEIGHBOURS: [(isize, isize); 8] = [
 ];
 
 /// The canvas SDF of one layer colour (or of all ink, `None`) for a
-/// synthesized query, px; [`PAPER`] off the ornament. Each pixel `p`
+/// synthesized query, px; `PAPER` off the ornament. Each pixel `p`
 /// blends the predictions of its 3×3 neighbourhood: neighbour `q` predicts
 /// the coordinate `μ(q) + J(q)(p − q)` (its patch continued to `p`,
 /// [`synth::jacobian`]) and gives the exemplar's SDF there (bilinear);

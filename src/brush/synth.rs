@@ -212,7 +212,7 @@ pub fn jacobian(style: &BrushStyle, field: &Field, x: usize, y: usize) -> Option
 }
 
 /// The appearance of a field: per pixel, the exemplar's all-ink SDF at μ
-/// (px), [`PAPER`] off the ornament.
+/// (px), `PAPER` off the ornament.
 pub fn appearance(style: &BrushStyle, field: &Field) -> Grid<f32> {
     let (w, h) = (field.coords.width(), field.coords.height());
     let rows: Vec<Vec<f32>> = (0..h)

@@ -125,7 +125,7 @@ fn pruned(ink: &Grid<bool>, counted: &Grid<bool>, min_branch: usize) -> (Grid<bo
 }
 
 /// Band ends of `ink` at pixels where `counted` is true: the end points of
-/// the skeleton pruned `min_branch` times (see [`pruned`]), an isolated
+/// the skeleton pruned `min_branch` times (see `pruned`), an isolated
 /// pixel counting as two, plus the short pieces pruning took whole.
 pub fn band_ends(ink: &Grid<bool>, counted: &Grid<bool>, min_branch: usize) -> usize {
     let (s, mut ends) = pruned(ink, counted, min_branch);

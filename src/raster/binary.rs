@@ -28,7 +28,7 @@
 //!    interior ones: the ends chamfer the corner), kept within half a pixel
 //!    of where it was. Where the outline makes a U-turn over a vertex or a
 //!    short edge (the end of a line up to 3½ px wide), the turn becomes a
-//!    square cap at the farthest pixel edge ([`super::line_ends`]).
+//!    square cap at the farthest pixel edge (`super::line_ends`).
 //! 5. **Smoothing.** Each vertex becomes either a corner or a cubic from
 //!    the midpoint of its incoming edge to the midpoint of its outgoing
 //!    edge, with control points a fraction `α` of the way to the vertex; `α`
@@ -37,11 +37,11 @@
 //!    `α ≥` [`ALPHA_MAX`] stays a corner (potrace's `alphamax`).
 //!
 //! 6. **Relaxing.** The flattened curves are smoothed along their arc
-//!    length between corners (a biweight of radius [`RELAX_RADIUS`], with
+//!    length between corners (a biweight of radius `RELAX_RADIUS`, with
 //!    Taubin's inflating second pass so loops do not shrink): step 5's
 //!    cubics bunch their turning next to the polygon vertices, and a
 //!    fitter that follows them needs more curves than the drawing had.
-//!    Tangents are taken as chords over ±[`TANGENT_REACH`] px.
+//!    Tangents are taken as chords over ±`TANGENT_REACH` px.
 //!
 //! `flourish trace` fits Béziers to these loops directly
 //! ([`smooth_loops`], [`crate::trace::trace_outline`]); other modes that

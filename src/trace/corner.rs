@@ -17,7 +17,7 @@ const CORNER_ANGLE: f64 = 55.0 * std::f64::consts::PI / 180.0;
 const CORNER_SEPARATION: f64 = 0.9;
 
 /// Indices of the corner vertices of a closed polygon: turning by more
-/// than [`CORNER_ANGLE`] within ±[`CORNER_WINDOW`] px, the sharpest vertex
+/// than `CORNER_ANGLE` within ±`CORNER_WINDOW` px, the sharpest vertex
 /// of each such stretch.
 pub fn corners(pts: &[Point]) -> Vec<usize> {
     let n = pts.len();

@@ -2,12 +2,12 @@
 //! cubic Béziers a greedy cover of each corner-free run finds.
 //!
 //! Each run between two corners (or a whole loop without corners) is one
-//! fitting source ([`Piece`], tangents given by the outline, exact area and
+//! fitting source (`Piece`, tangents given by the outline, exact area and
 //! moment integrals of the polyline). From the start of what is left, the
 //! longest span that one cubic fits is searched for (the direct fitter of
-//! [`super::direct`], which matches area and first moment under the end
+//! `super::direct`, which matches area and first moment under the end
 //! tangents and judges each candidate by the outline itself both ways; see
-//! [`super::span::fit_span`]), halving and then bisecting down to an
+//! `super::span::fit_span`), halving and then bisecting down to an
 //! eighth of the span; the span is only capped by how much the outline turns
 //! within it ([`MAX_SPAN_TURN`]), not cut into fixed pieces beforehand, so
 //! a run costs no more cubics than its shape needs. When fitting is

@@ -6,11 +6,11 @@
 //! tangents perpendicular to the SDF gradient, which is smooth where the
 //! outline is, so pieces join with G1 continuity. `fit_to_bezpath_opt`
 //! then finds the fewest cubics within the tolerance. An outline known
-//! exactly (a bitmap's smoothed or sub-pixel outline) is a [`Piece`] too,
+//! exactly (a bitmap's smoothed or sub-pixel outline) is a `Piece` too,
 //! covered by [`super::cover`] with its own tangents and corners, exact
-//! moment integrals, and fitted by [`super::direct`] (no kurbo), each curve
+//! moment integrals, and fitted by `super::direct` (no kurbo), each curve
 //! checked against the outline itself (and a binary bitmap's corridor)
-//! instead of an SDF. The span search both share is [`super::span`]. Corners are the
+//! instead of an SDF. The span search both share is `super::span`. Corners are the
 //! vertices where the outline turns sharply within a pixel-scale window;
 //! the curves meet there at an angle, so sharp corners stay sharp.
 
