@@ -375,11 +375,15 @@ fn relax(l: &mut SmoothLoop) {
             })
             .collect()
     };
-    let before = contour::signed_area(&l.points);
+    // Only a corner-free loop can be moved out as a whole (see keep_area).
+    let before = l
+        .corners
+        .is_empty()
+        .then(|| contour::signed_area(&l.points));
     let a = pass(&l.points, 1.0);
     l.points = pass(&a, -1.0 / 0.9);
-    if l.corners.is_empty() {
-        keep_area(&mut l.points, before);
+    if let Some(area) = before {
+        keep_area(&mut l.points, area);
     }
 }
 

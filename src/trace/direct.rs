@@ -20,7 +20,7 @@
 //! separate error measure along normals is needed.
 
 use super::fit::Piece;
-use super::nearest::nearest_segment;
+use super::nearest::nearest_from;
 use super::span::FIT_SAMPLES;
 use kurbo::common::{factor_quartic_inner, solve_cubic, solve_quadratic};
 use kurbo::{CubicBez, ParamCurve, Point, Vec2};
@@ -276,15 +276,8 @@ fn outline_to_curve(curve: &CurvePoints, samples: &[(Point, Vec2)], limit: f64) 
     let total = cum[CURVE_POINTS];
     let slack = 2.0 * limit + STEP_SLACK * total;
     for (i, &(q, _)) in interior.iter().enumerate() {
-        let found = match nearest_segment(pts, cum, q, cursor, last, limit, limit) {
-            (Some(j), d) => Some((j, d)),
-            _ if cursor > 0 => match nearest_segment(pts, cum, q, 0, cursor - 1, limit, limit) {
-                (Some(j), d) => Some((j, d)),
-                _ => None,
-            },
-            _ => None,
-        };
-        let (mut j, mut best) = found?;
+        let (found, d) = nearest_from(pts, cum, q, 0, cursor, last, limit, limit);
+        let (mut j, mut best) = (found?, d);
         // Downhill to the nearest chord around it.
         loop {
             let fwd = if j < last {

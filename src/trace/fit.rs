@@ -15,7 +15,7 @@
 //! the curves meet there at an angle, so sharp corners stay sharp.
 
 use super::corner::corners;
-use super::nearest::{gallop_le as gallop, nearest_segment};
+use super::nearest::{gallop_le as gallop, nearest_from};
 use super::span::{append_loop, line_cubic, longest_span, FIT_SAMPLES};
 use crate::raster::corridor::Corridor;
 use crate::raster::Sdf;
@@ -247,29 +247,11 @@ impl<'a> Piece<'a> {
                 } else {
                     near
                 };
-                // Consecutive points are usually near the same segment or
-                // just ahead of it: search from the last one found onwards,
-                // then the rest.
                 let mut cursor = lo;
                 let mut pts = pts;
                 pts.all(|p| {
                     let (found, best) =
-                        match nearest_segment(&self.pts, &self.cum, p, cursor, hi, near, far) {
-                            (Some(j), d) => (Some(j), d),
-                            (None, d) if cursor > lo => {
-                                let (j, d2) = nearest_segment(
-                                    &self.pts,
-                                    &self.cum,
-                                    p,
-                                    lo,
-                                    cursor - 1,
-                                    near,
-                                    far,
-                                );
-                                (j, d.min(d2))
-                            }
-                            miss => miss,
-                        };
+                        nearest_from(&self.pts, &self.cum, p, lo, cursor, hi, near, far);
                     if let Some(j) = found {
                         cursor = j;
                     }

@@ -58,34 +58,56 @@ pub(super) fn nearest_segment(
     (None, best)
 }
 
+/// [`nearest_segment`] for consecutive points along a curve: segments
+/// `cursor..=hi` first (a point is usually near the segment the last one
+/// was, or just ahead), then `lo..cursor`. Returns a segment within `near`
+/// if either finds one, else the distance of the closest within `far`.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn nearest_from(
+    pts: &[Point],
+    cum: &[f64],
+    p: Point,
+    lo: usize,
+    cursor: usize,
+    hi: usize,
+    near: f64,
+    far: f64,
+) -> (Option<usize>, f64) {
+    match nearest_segment(pts, cum, p, cursor, hi, near, far) {
+        (None, d) if cursor > lo => {
+            let (j, d2) = nearest_segment(pts, cum, p, lo, cursor - 1, near, far);
+            (j, d.min(d2))
+        }
+        found => found,
+    }
+}
+
 /// The number of leading values of ascending `c` below `target`, found by
 /// doubling steps and then bisecting: the skips in [`nearest_segment`]
 /// are mostly a few segments, now and then thousands.
 fn gallop(c: &[f64], target: f64) -> usize {
-    let (mut lo, mut hi) = (0usize, 1usize);
-    while hi <= c.len() && c[hi - 1] < target {
-        lo = hi;
-        hi *= 2;
-    }
-    let hi = hi.min(c.len());
-    lo + c
-        .get(lo..hi)
-        .map_or(0, |c| c.partition_point(|&x| x < target))
+    gallop_while(c, |x| x < target)
 }
 
 /// The number of leading values of ascending `c` at or below `target`,
 /// by doubling steps and then bisecting ([`crate::trace::fit`]'s `locate`
 /// walks forwards from the segment it found last).
 pub(super) fn gallop_le(c: &[f64], target: f64) -> usize {
+    gallop_while(c, |x| x <= target)
+}
+
+/// The length of the leading run of `c` where `ahead` holds (`c` ascends,
+/// so it holds on a prefix): doubling steps, then bisection.
+fn gallop_while(c: &[f64], ahead: impl Fn(f64) -> bool) -> usize {
     let (mut lo, mut hi) = (0usize, 1usize);
-    while hi <= c.len() && c[hi - 1] <= target {
+    while hi <= c.len() && ahead(c[hi - 1]) {
         lo = hi;
         hi *= 2;
     }
     let hi = hi.min(c.len());
     lo + c
         .get(lo..hi)
-        .map_or(0, |c| c.partition_point(|&x| x <= target))
+        .map_or(0, |c| c.partition_point(|&x| ahead(x)))
 }
 
 #[cfg(test)]
