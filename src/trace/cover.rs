@@ -19,7 +19,7 @@
 //! outline's tangent at the join.
 
 use super::fit::{corner_runs, Guide, Piece};
-use super::span::{append_loop, line_cubic, longest_span, MIN_SPAN_PX};
+use super::span::{append_loop, line_cubic, longest_span, CHORD_SHARE, MIN_SPAN_PX};
 use crate::raster::corridor::Corridor;
 use kurbo::{BezPath, CubicBez, Point, Vec2};
 use rayon::prelude::*;
@@ -125,11 +125,16 @@ fn cover_run(piece: &Piece, accuracy: f64, out: &mut Vec<CubicBez>) {
     if n < 2 || total <= 1e-9 {
         return;
     }
+    // A run as straight as its chord is that chord, held to the share of
+    // the accuracy any straight chord gets (`span::fit_span`): a straight
+    // side allowed the whole tolerance sits a quarter pixel off along its
+    // whole length, a sixth of a 1.5-px line's weight.
     let (a, b) = (piece.point(0), piece.point(n - 1));
     let chord = kurbo::Line::new(a, b);
+    let limit = CHORD_SHARE * accuracy;
     if a != b
         && (0..n)
-            .all(|i| crate::raster::sdf::point_segment_distance(piece.point(i), chord) <= accuracy)
+            .all(|i| crate::raster::sdf::point_segment_distance(piece.point(i), chord) <= limit)
     {
         out.push(line_cubic(a, b));
         return;

@@ -119,7 +119,7 @@ pub(super) fn fit_span(piece: &Piece, range: Range<f64>, accuracy: f64) -> Optio
 }
 
 /// The share of the accuracy a straight chord may use (see [`fit_span`]).
-const CHORD_SHARE: f64 = 0.6;
+pub(super) const CHORD_SHARE: f64 = 0.6;
 
 /// Appends the piece's polygon over `range` as straight cubics, simplified
 /// to the fewest of its vertices that keep every other one within
