@@ -15,7 +15,7 @@
 //! the curves meet there at an angle, so sharp corners stay sharp.
 
 use super::corner::corners;
-use super::nearest::{gallop_le as gallop, nearest_from};
+use super::nearest::{gallop_back_le, gallop_le as gallop, nearest_from};
 use super::span::{append_loop, line_cubic, longest_span, FIT_SAMPLES};
 use crate::raster::corridor::Corridor;
 use crate::raster::Sdf;
@@ -248,12 +248,26 @@ impl<'a> Piece<'a> {
                     near
                 };
                 let mut cursor = lo;
+                // The last point found within `near` of segment `cursor`
+                // and how much further a point may be from it and still be
+                // (the triangle inequality): consecutive points of a curve
+                // mostly are, and need no search.
+                let mut anchor: Option<(Point, f64)> = None;
                 let mut pts = pts;
                 pts.all(|p| {
+                    if let Some((q, slack)) = anchor {
+                        let step = (p - q).hypot();
+                        if step <= slack {
+                            anchor = Some((p, slack - step));
+                            return true;
+                        }
+                    }
                     let (found, best) =
                         nearest_from(&self.pts, &self.cum, p, lo, cursor, hi, near, far);
+                    anchor = None;
                     if let Some(j) = found {
                         cursor = j;
+                        anchor = Some((p, near - best));
                     }
                     best <= near || best <= far && corridor.is_some_and(|c| c.reaches(p, limit))
                 })
@@ -263,8 +277,8 @@ impl<'a> Piece<'a> {
 
     /// Segment index and position at arc length `s` (clamped to the
     /// piece): the segment `i` with `cum[i] ≤ s < cum[i + 1]` (the last one
-    /// at the end), tried first at and after the last one found, then by
-    /// binary search.
+    /// at the end), tried first at the last one found, then by galloping
+    /// forwards or backwards from it.
     pub(super) fn locate(&self, s: f64) -> (usize, Point) {
         let n = self.pts.len();
         let s = s.clamp(0.0, self.length());
@@ -277,10 +291,10 @@ impl<'a> Piece<'a> {
             let ahead = self.cum.get(h + 1..).unwrap_or(&[]);
             (h + gallop(ahead, s)).min(n - 2)
         } else {
-            self.cum
-                .partition_point(|&c| c <= s)
-                .saturating_sub(1)
-                .min(n - 2)
+            // Behind it: gallop backwards (the next span starts where the
+            // last one did).
+            let behind = self.cum.get(..h).unwrap_or(&[]);
+            gallop_back_le(behind, s).saturating_sub(1).min(n - 2)
         };
         self.hint.set(i);
         let seg = self.cum[i + 1] - self.cum[i];
@@ -326,7 +340,7 @@ impl ParamCurveFit for Piece<'_> {
     fn sample_pt_tangent(&self, t: f64, sign: f64) -> CurveFitSample {
         let s = t * self.length();
         let (i, p) = self.locate(s);
-        let travel = self.seg_dir(i);
+        let travel = || self.seg_dir(i);
         let at_start = t <= 0.0;
         let at_end = t >= 1.0;
         let len = self.length();
@@ -352,16 +366,16 @@ impl ParamCurveFit for Piece<'_> {
             let l = perp.hypot();
             if l > 1e-6 {
                 let d = perp / l;
-                if d.dot(travel) < 0.0 {
+                if d.dot(travel()) < 0.0 {
                     -d
                 } else {
                     d
                 }
             } else {
-                travel
+                travel()
             }
         } else {
-            travel
+            travel()
         };
         CurveFitSample {
             p: p - self.origin,
@@ -406,14 +420,33 @@ impl Piece<'_> {
     /// Position (px) and unit tangent at `t` (a share of the length) for
     /// each of [`FIT_SAMPLES`] points evenly spread over `range`, where
     /// kurbo's fitter samples them.
+    #[cfg(test)]
     pub(super) fn samples(&self, range: Range<f64>) -> [(Point, Vec2); FIT_SAMPLES] {
+        let all = self.samples_while(range, |_, _| true);
+        all.unwrap_or([(Point::ORIGIN, Vec2::ZERO); FIT_SAMPLES])
+    }
+
+    /// [`Self::samples`], taken in order and given up (`None`) as soon as
+    /// `ok` rejects the tangents of two neighbouring samples: a span the
+    /// fitter refuses for bending too sharply costs only the samples up to
+    /// the bend.
+    pub(super) fn samples_while(
+        &self,
+        range: Range<f64>,
+        ok: impl Fn(Vec2, Vec2) -> bool,
+    ) -> Option<[(Point, Vec2); FIT_SAMPLES]> {
         let step = (range.end - range.start) / (FIT_SAMPLES - 1) as f64;
         let mut out = [(Point::ORIGIN, Vec2::ZERO); FIT_SAMPLES];
+        let mut prev: Option<Vec2> = None;
         for (i, o) in out.iter_mut().enumerate() {
             let s = self.sample_pt_tangent(range.start + i as f64 * step, 1.0);
+            if prev.is_some_and(|t| !ok(t, s.tangent)) {
+                return None;
+            }
+            prev = Some(s.tangent);
             *o = (s.p + self.origin, s.tangent);
         }
-        out
+        Some(out)
     }
 
     /// Position (px) and unit tangent at the start (`at_start`) or end of
