@@ -117,8 +117,14 @@ pub(super) fn fit_span(piece: &Piece, range: Range<f64>, accuracy: f64) -> Optio
             .all(near_chord)
             && inner.iter().all(near_chord);
         let on_level_set = || {
+            // On an outline, as a cubic's (see `super::direct`): at most
+            // 0.4 px apart.
+            let m = match piece.guide {
+                Guide::Outline(_) => (((b - a).hypot() / 0.4).ceil() as usize).clamp(16, 64),
+                Guide::Field(_) => 64,
+            };
             piece.holds(
-                (1..64).map(|k| a.lerp(b, k as f64 / 64.0)),
+                (1..m).map(|k| a.lerp(b, k as f64 / m as f64)),
                 s0,
                 s1,
                 CHORD_SHARE * accuracy,
