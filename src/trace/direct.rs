@@ -307,22 +307,36 @@ fn outline_to_curve(curve: &CurvePoints, samples: &[(Point, Vec2)], limit: f64) 
     for (i, &(q, _)) in interior.iter().enumerate() {
         let (found, d) = nearest_from(pts, cum, q, 0, cursor, last, limit, limit);
         let (mut j, mut best) = (found?, d);
-        // Downhill to the nearest chord around it.
-        loop {
-            let fwd = if j < last {
-                dist(q, j + 1)
-            } else {
-                f64::INFINITY
-            };
-            let back = if j > 0 { dist(q, j - 1) } else { f64::INFINITY };
-            if fwd < best && fwd <= back {
-                best = fwd;
+        // Downhill to the nearest chord around it: the closer neighbour
+        // (ahead on a tie) while it is closer, and on in that direction
+        // only (the chord just left is farther than the new one).
+        let fwd = if j < last {
+            dist(q, j + 1)
+        } else {
+            f64::INFINITY
+        };
+        let back = if j > 0 { dist(q, j - 1) } else { f64::INFINITY };
+        if fwd < best && fwd <= back {
+            best = fwd;
+            j += 1;
+            while j < last {
+                let d = dist(q, j + 1);
+                if d >= best {
+                    break;
+                }
+                best = d;
                 j += 1;
-            } else if back < best {
-                best = back;
+            }
+        } else if back < best {
+            best = back;
+            j -= 1;
+            while j > 0 {
+                let d = dist(q, j - 1);
+                if d >= best {
+                    break;
+                }
+                best = d;
                 j -= 1;
-            } else {
-                break;
             }
         }
         // Where along the curve the sample landed, against where it would

@@ -297,13 +297,30 @@ impl<'a> Piece<'a> {
             gallop_back_le(behind, s).saturating_sub(1).min(n - 2)
         };
         self.hint.set(i);
+        (i, self.point_on(i, s))
+    }
+
+    /// The point at arc length `s` (within the piece) on segment `i`.
+    fn point_on(&self, i: usize, s: f64) -> Point {
         let seg = self.cum[i + 1] - self.cum[i];
         let t = if seg > 0.0 {
             (s - self.cum[i]) / seg
         } else {
             0.0
         };
-        (i, self.pts[i].lerp(self.pts[i + 1], t))
+        self.pts[i].lerp(self.pts[i + 1], t)
+    }
+
+    /// [`Self::locate`] for arc lengths visited in ascending order: from
+    /// the segment `i` found for an earlier one, a step at a time.
+    fn locate_after(&self, i: usize, s: f64) -> (usize, Point) {
+        let n = self.pts.len();
+        let s = s.clamp(0.0, self.length());
+        let mut i = i.min(n - 2);
+        while i + 2 < n && self.cum[i + 1] <= s {
+            i += 1;
+        }
+        (i, self.point_on(i, s))
     }
 
     fn seg_dir(&self, i: usize) -> Vec2 {
@@ -338,8 +355,48 @@ impl<'a> Piece<'a> {
 
 impl ParamCurveFit for Piece<'_> {
     fn sample_pt_tangent(&self, t: f64, sign: f64) -> CurveFitSample {
+        let located = self.locate(t * self.length());
+        self.sample_at(t, sign, located)
+    }
+
+    fn sample_pt_deriv(&self, t: f64) -> (Point, Vec2) {
         let s = t * self.length();
         let (i, p) = self.locate(s);
+        (p - self.origin, self.seg_dir(i) * self.length())
+    }
+
+    fn moment_integrals(&self, range: Range<f64>) -> (f64, f64, f64) {
+        if self.moments.len() != self.pts.len() {
+            return self.quadrature_moments(range);
+        }
+        // Exact: the integrals of y dx, x y dx and y² dx over the polyline,
+        // partial segments at both ends and prefix sums between.
+        let len = self.length();
+        let (i0, p0) = self.locate(range.start * len);
+        let (i1, p1) = self.locate(range.end * len);
+        let o = self.origin;
+        let m = if i0 == i1 {
+            segment_moments(p0 - o, p1 - o)
+        } else {
+            let a = segment_moments(p0 - o, self.pts[i0 + 1] - o);
+            let b = segment_moments(self.pts[i1] - o, p1 - o);
+            let (lo, hi) = (self.moments[i0 + 1], self.moments[i1]);
+            [0, 1, 2].map(|k| a[k] + (hi[k] - lo[k]) + b[k])
+        };
+        (m[0], m[1], m[2])
+    }
+
+    fn break_cusp(&self, _range: Range<f64>) -> Option<f64> {
+        // Corners were cut before fitting.
+        None
+    }
+}
+
+impl Piece<'_> {
+    /// The sample at `t` (a share of the length; `sign` picks the side at
+    /// a corner) on the located segment and point `(i, p)`.
+    fn sample_at(&self, t: f64, sign: f64, (i, p): (usize, Point)) -> CurveFitSample {
+        let s = t * self.length();
         let travel = || self.seg_dir(i);
         let at_start = t <= 0.0;
         let at_end = t >= 1.0;
@@ -383,40 +440,6 @@ impl ParamCurveFit for Piece<'_> {
         }
     }
 
-    fn sample_pt_deriv(&self, t: f64) -> (Point, Vec2) {
-        let s = t * self.length();
-        let (i, p) = self.locate(s);
-        (p - self.origin, self.seg_dir(i) * self.length())
-    }
-
-    fn moment_integrals(&self, range: Range<f64>) -> (f64, f64, f64) {
-        if self.moments.len() != self.pts.len() {
-            return self.quadrature_moments(range);
-        }
-        // Exact: the integrals of y dx, x y dx and y² dx over the polyline,
-        // partial segments at both ends and prefix sums between.
-        let len = self.length();
-        let (i0, p0) = self.locate(range.start * len);
-        let (i1, p1) = self.locate(range.end * len);
-        let o = self.origin;
-        let m = if i0 == i1 {
-            segment_moments(p0 - o, p1 - o)
-        } else {
-            let a = segment_moments(p0 - o, self.pts[i0 + 1] - o);
-            let b = segment_moments(self.pts[i1] - o, p1 - o);
-            let (lo, hi) = (self.moments[i0 + 1], self.moments[i1]);
-            [0, 1, 2].map(|k| a[k] + (hi[k] - lo[k]) + b[k])
-        };
-        (m[0], m[1], m[2])
-    }
-
-    fn break_cusp(&self, _range: Range<f64>) -> Option<f64> {
-        // Corners were cut before fitting.
-        None
-    }
-}
-
-impl Piece<'_> {
     /// Position (px) and unit tangent at `t` (a share of the length) for
     /// each of [`FIT_SAMPLES`] points evenly spread over `range`, where
     /// kurbo's fitter samples them.
@@ -438,8 +461,17 @@ impl Piece<'_> {
         let step = (range.end - range.start) / (FIT_SAMPLES - 1) as f64;
         let mut out = [(Point::ORIGIN, Vec2::ZERO); FIT_SAMPLES];
         let mut prev: Option<Vec2> = None;
+        // The samples ascend: each segment is found by stepping on from
+        // the last one.
+        let mut seg = None;
         for (i, o) in out.iter_mut().enumerate() {
-            let s = self.sample_pt_tangent(range.start + i as f64 * step, 1.0);
+            let t = range.start + i as f64 * step;
+            let located = match seg {
+                Some(j) if step >= 0.0 => self.locate_after(j, t * self.length()),
+                _ => self.locate(t * self.length()),
+            };
+            seg = Some(located.0);
+            let s = self.sample_at(t, 1.0, located);
             if prev.is_some_and(|t| !ok(t, s.tangent)) {
                 return None;
             }
@@ -676,6 +708,28 @@ mod tests {
                 ((x as f64 + 0.5 - cx).hypot(y as f64 + 0.5 - cy) - r) as f32
             }),
             to_user: Affine::IDENTITY,
+        }
+    }
+
+    proptest::proptest! {
+        /// Stepping on from an earlier arc length's segment finds what a
+        /// search from scratch does (zero-length segments included).
+        #[test]
+        fn locate_after_agrees_with_locate(
+            gaps in proptest::collection::vec(proptest::sample::select(vec![0.0, 0.3, 1.0, 2.5]), 1..30),
+            a in 0.0f64..1.1,
+            b in 0.0f64..1.1,
+        ) {
+            let mut pts = vec![Point::new(3.0, 4.0)];
+            for (k, g) in gaps.iter().enumerate() {
+                let last = pts[pts.len() - 1];
+                pts.push(last + Vec2::new(*g, 0.1 * (k % 3) as f64 * g));
+            }
+            let piece = Piece::new(pts, Vec::new(), Guide::Outline(None), false, false);
+            let len = piece.length();
+            let (s1, s2) = (a.min(b) * len, a.max(b) * len);
+            let (j, _) = piece.locate(s1);
+            proptest::prop_assert_eq!(piece.locate_after(j, s2), piece.locate(s2));
         }
     }
 
