@@ -16,6 +16,7 @@ pub mod cover;
 mod direct;
 pub mod fit;
 mod nearest;
+mod sample;
 mod span;
 
 use crate::error::{Error, Result};
