@@ -34,15 +34,20 @@ pub(super) fn nearest_segment(
     let mut bound = far;
     let mut j = from;
     while j <= to && j < pts.len().saturating_sub(1) {
-        let reach = (p - pts[j]).hypot() - bound - MARGIN;
-        if reach > 0.0 {
+        // Squared first: most points are within the bound of the vertex.
+        let v2 = (p - pts[j]).hypot2();
+        let r = bound + MARGIN;
+        if v2 > r * r {
+            let reach = v2.sqrt() - r;
             // Skip the segments ending less than `reach` further on
-            // (`cum` ascends).
+            // (`cum` ascends); none when segment j itself reaches that far.
             let target = cum[j] + reach;
-            let skip = cum.get(j + 1..to + 2).map_or(0, |c| gallop(c, target));
-            if skip > 0 {
-                j += skip;
-                continue;
+            if cum.get(j + 1).is_some_and(|&c| c < target) {
+                let skip = cum.get(j + 1..to + 2).map_or(0, |c| gallop(c, target));
+                if skip > 0 {
+                    j += skip;
+                    continue;
+                }
             }
         }
         let d = crate::raster::sdf::point_segment_distance(p, kurbo::Line::new(pts[j], pts[j + 1]));
