@@ -20,12 +20,12 @@ const BINARY_SAMPLES: [&str; 4] = [
 ];
 
 /// The target: at least as accurate and as compact as potrace on
-/// every binary sample. Not met yet (flourish has 1.08× potrace's
-/// segments on the binary glyph and 1.39× on the binary thin lines, its
+/// every binary sample. Not met yet (flourish has 1.05× potrace's
+/// segments on the binary glyph and 1.40× on the binary thin lines, its
 /// symmetric deviation on the 2 Mpx ornament and the binary glyph is
 /// larger, and thin lines render back at IoU 0.92); run with `--ignored`.
 #[test]
-#[ignore = "target not yet met on every sample: segments 0.70-1.39x potrace's; see README benchmark table"]
+#[ignore = "target not yet met on every sample: segments 0.70-1.40x potrace's; see README benchmark table"]
 fn flourish_beats_potrace_on_binary_samples() {
     if !support::potrace_available() {
         let msg =

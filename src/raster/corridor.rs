@@ -18,6 +18,7 @@
 use super::paths::Bitmap;
 use super::{Coverage, Grid};
 use kurbo::Point;
+use rayon::prelude::*;
 
 /// The mixed cells of a binary bitmap (see the module docs).
 #[derive(Clone, Debug)]
@@ -44,14 +45,21 @@ impl Corridor {
         let (w, h) = (bits.width(), bits.height());
         // Padded row y + 1 holds pixel row y between two paper flags, so
         // cell (ci, cj) has the padded corners (ci, cj) to (ci + 1, cj + 1).
-        let mut mixed = Vec::with_capacity((w + 1) * (h + 1));
-        let rows = bits.padded_rows();
-        for (top, bottom) in rows.clone().zip(rows.skip(1)) {
-            for (t, b) in top.windows(2).zip(bottom.windows(2)) {
-                let a = t[0];
-                mixed.push(a != t[1] || a != b[0] || a != b[1]);
-            }
-        }
+        // Rows of cells in parallel (a 2 Mpx bitmap has 2 M cells), each
+        // from its two padded rows of flags.
+        let rows: Vec<&[u8]> = bits.padded_rows().collect();
+        let mut mixed = vec![false; (w + 1) * (h + 1)];
+        mixed
+            .par_chunks_mut(w + 1)
+            .zip(rows.par_windows(2))
+            .for_each(|(out, pair)| {
+                let (top, bottom) = (pair[0], pair[1]);
+                let (top1, bottom1) = (top.get(1..).unwrap_or(&[]), bottom.get(1..).unwrap_or(&[]));
+                let cells = top.iter().zip(top1).zip(bottom.iter().zip(bottom1));
+                for (o, ((&a, &b), (&c, &d))) in out.iter_mut().zip(cells) {
+                    *o = a != b || a != c || a != d;
+                }
+            });
         let mixed = Grid::from_vec(w + 1, h + 1, mixed).unwrap_or_else(|| Grid::new(0, 0, false));
         Corridor { mixed }
     }

@@ -163,9 +163,22 @@ const HANDLE_ELBOW: f64 = 0.65;
 /// How much more: the error scales by `1 + 2 (d − elbow)` beyond it.
 const HANDLE_SLOPE: f64 = 2.0;
 
-/// Points checked on a candidate: first every eighth (a cheap rejection of
-/// most misfits), then the rest.
+/// Most chords a candidate is flattened into (and points it is checked
+/// at): first every eighth point (a cheap rejection of most misfits), then
+/// the rest.
 const CURVE_POINTS: usize = 64;
+
+/// Fewest chords a candidate is flattened into.
+const MIN_CURVE_POINTS: usize = 16;
+
+/// Longest chord (px, measured on the control polygon, which bounds the
+/// arc length from above) a candidate is flattened into, between
+/// [`MIN_CURVE_POINTS`] and [`CURVE_POINTS`]: the outline check at points
+/// this far apart along a curve that stays nearly parallel to the outline
+/// misses less than a hundredth of a pixel between them, and a short span
+/// needs far fewer than 64 points (the spans of the 2 Mpx ornament are
+/// about 10 px long).
+const CURVE_SPACING: f64 = 0.4;
 
 /// The cubic matching `piece`'s area and moment over `range` (shares of its
 /// length) that lies within `accuracy` of the outline both ways: each of
@@ -212,7 +225,7 @@ pub(super) fn fit_span_direct(
     let len = piece.length() * (range.end - range.start);
     let (s0, s1) = (range.start * piece.length(), range.end * piece.length());
     // Coarse first: most misfits fail at one of every eighth point.
-    let inner = &pts.pts[1..CURVE_POINTS];
+    let inner = pts.pts.get(1..pts.m).unwrap_or(&[]);
     let coarse = inner.iter().skip(7).step_by(8).copied();
     let fine = inner
         .iter()
@@ -223,30 +236,45 @@ pub(super) fn fit_span_direct(
     // polygon from above.
     let polygon = (c.p1 - c.p0).hypot() + (c.p2 - c.p1).hypot() + (c.p3 - c.p2).hypot();
     let short = polygon <= 1.5 * len + 0.5
-        || pts.cum[CURVE_POINTS] <= 1.5 * len + 0.5
+        || pts.cum[pts.m] <= 1.5 * len + 0.5
             && kurbo::ParamCurveArclen::arclen(&c, 0.01) <= 1.5 * len + 0.5;
     (short && piece.holds(coarse, s0, s1, accuracy) && piece.holds(fine, s0, s1, accuracy))
         .then_some(c)
 }
 
-/// A cubic flattened at [`CURVE_POINTS`] + 1 evenly spaced parameters,
-/// with the cumulative length (px) of the chords.
+/// A cubic flattened at `m` + 1 evenly spaced parameters (`m` chords of
+/// at most about [`CURVE_SPACING`] px), with the cumulative length (px)
+/// of the chords; entries past `m` are unused.
 struct CurvePoints {
     pts: [Point; CURVE_POINTS + 1],
     cum: [f64; CURVE_POINTS + 1],
+    m: usize,
 }
 
 impl CurvePoints {
     fn new(c: &CubicBez) -> Self {
+        let polygon = (c.p1 - c.p0).hypot() + (c.p2 - c.p1).hypot() + (c.p3 - c.p2).hypot();
+        // A NaN length casts to 0: the fewest chords.
+        let m = ((polygon / CURVE_SPACING).ceil() as usize).clamp(MIN_CURVE_POINTS, CURVE_POINTS);
         let mut pts = [Point::ORIGIN; CURVE_POINTS + 1];
         let mut cum = [0.0; CURVE_POINTS + 1];
-        for k in 0..=CURVE_POINTS {
-            pts[k] = c.eval(k as f64 / CURVE_POINTS as f64);
+        for k in 0..=m {
+            pts[k] = c.eval(k as f64 / m as f64);
             if k > 0 {
                 cum[k] = cum[k - 1] + (pts[k] - pts[k - 1]).hypot();
             }
         }
-        CurvePoints { pts, cum }
+        CurvePoints { pts, cum, m }
+    }
+
+    /// The flattened points, `m` + 1 of them.
+    fn points(&self) -> &[Point] {
+        self.pts.get(..=self.m).unwrap_or(&[])
+    }
+
+    /// Their cumulative lengths (px).
+    fn lengths(&self) -> &[f64] {
+        self.cum.get(..=self.m).unwrap_or(&[])
     }
 }
 
@@ -263,37 +291,52 @@ const STEP_SLACK: f64 = 0.15;
 /// [`nearest_segment`]), then followed downhill to a local minimum: an upper
 /// bound of the distance, exact where the curve is smooth.
 fn outline_to_curve(curve: &CurvePoints, samples: &[(Point, Vec2)], limit: f64) -> Option<f64> {
-    let (pts, cum) = (&curve.pts, &curve.cum);
+    let (pts, cum) = (curve.points(), curve.lengths());
+    let m = curve.m;
     let dist = |q: Point, j: usize| {
         crate::raster::sdf::point_segment_distance(q, kurbo::Line::new(pts[j], pts[j + 1]))
     };
-    let last = CURVE_POINTS - 1;
+    let last = m - 1;
     let mut cursor = 0usize;
     let mut worst: f64 = 0.0;
     let interior = samples
         .get(1..samples.len().saturating_sub(1))
         .unwrap_or(&[]);
-    let total = cum[CURVE_POINTS];
+    let total = cum[m];
     let slack = 2.0 * limit + STEP_SLACK * total;
     for (i, &(q, _)) in interior.iter().enumerate() {
         let (found, d) = nearest_from(pts, cum, q, 0, cursor, last, limit, limit);
         let (mut j, mut best) = (found?, d);
-        // Downhill to the nearest chord around it.
-        loop {
-            let fwd = if j < last {
-                dist(q, j + 1)
-            } else {
-                f64::INFINITY
-            };
-            let back = if j > 0 { dist(q, j - 1) } else { f64::INFINITY };
-            if fwd < best && fwd <= back {
-                best = fwd;
+        // Downhill to the nearest chord around it: the closer neighbour
+        // (ahead on a tie) while it is closer, and on in that direction
+        // only (the chord just left is farther than the new one).
+        let fwd = if j < last {
+            dist(q, j + 1)
+        } else {
+            f64::INFINITY
+        };
+        let back = if j > 0 { dist(q, j - 1) } else { f64::INFINITY };
+        if fwd < best && fwd <= back {
+            best = fwd;
+            j += 1;
+            while j < last {
+                let d = dist(q, j + 1);
+                if d >= best {
+                    break;
+                }
+                best = d;
                 j += 1;
-            } else if back < best {
-                best = back;
+            }
+        } else if back < best {
+            best = back;
+            j -= 1;
+            while j > 0 {
+                let d = dist(q, j - 1);
+                if d >= best {
+                    break;
+                }
+                best = d;
                 j -= 1;
-            } else {
-                break;
             }
         }
         // Where along the curve the sample landed, against where it would

@@ -2,7 +2,7 @@
 //!
 //! A contour (the marching-squares polygon of an SDF's zero level set) is
 //! cut at its corners and each piece is presented to kurbo as a
-//! [`ParamCurveFit`] source: positions along the polygon by arc length, and
+//! `kurbo::ParamCurveFit` source: positions along the polygon by arc length, and
 //! tangents perpendicular to the SDF gradient, which is smooth where the
 //! outline is, so pieces join with G1 continuity. `fit_to_bezpath_opt`
 //! then finds the fewest cubics within the tolerance. An outline known
@@ -10,22 +10,19 @@
 //! covered by [`super::cover`] with its own tangents and corners, exact
 //! moment integrals, and fitted by `super::direct` (no kurbo), each curve
 //! checked against the outline itself (and a binary bitmap's corridor)
-//! instead of an SDF. The span search both share is `super::span`. Corners are the
+//! instead of an SDF. The span search both share is `super::span`; how a
+//! piece is sampled and integrated is `super::sample`. Corners are the
 //! vertices where the outline turns sharply within a pixel-scale window;
 //! the curves meet there at an angle, so sharp corners stay sharp.
 
 use super::corner::corners;
-use super::nearest::{gallop_le as gallop, nearest_from};
-use super::span::{append_loop, line_cubic, longest_span, FIT_SAMPLES};
+use super::nearest::{gallop_back_le, gallop_le as gallop, nearest_from};
+use super::sample::segment_moments;
+use super::span::{append_loop, line_cubic, longest_span};
 use crate::raster::corridor::Corridor;
 use crate::raster::Sdf;
-use kurbo::{BezPath, CubicBez, CurveFitSample, ParamCurveFit, Point, Vec2};
+use kurbo::{BezPath, CubicBez, Point, Vec2};
 use std::cell::Cell;
-use std::ops::Range;
-
-/// Distance (px) from a corner within which tangents come from the polygon
-/// instead of the SDF gradient.
-const CORNER_REACH: f64 = 1.5;
 
 /// What a piece is fitted to: where its tangents come from and what the
 /// fitted curves are checked against.
@@ -46,7 +43,7 @@ pub(super) enum Guide<'a> {
 /// How far `p` (px) lies inside the canvas of `sdf`'s grid, negated: the
 /// signed distance of the canvas rectangle `[0, w] × [0, h]`, negative
 /// inside.
-fn canvas_value(sdf: &Sdf, p: Point) -> f64 {
+pub(super) fn canvas_value(sdf: &Sdf, p: Point) -> f64 {
     let (w, h) = (sdf.width() as f64, sdf.height() as f64);
     -(p.x.min(p.y).min(w - p.x).min(h - p.y))
 }
@@ -59,39 +56,24 @@ fn clipped_value(sdf: &Sdf, p: Point) -> f64 {
     sdf.value(p).max(canvas_value(sdf, p))
 }
 
-/// The gradient of [`clipped_value`]: the border's outward normal where
-/// the canvas term is the larger.
-fn clipped_gradient(sdf: &Sdf, p: Point) -> Vec2 {
-    let (w, h) = (sdf.width() as f64, sdf.height() as f64);
-    let c = canvas_value(sdf, p);
-    if c < sdf.value(p) {
-        return sdf.gradient(p);
-    }
-    let (ex, ey) = (Vec2::new(1.0, 0.0), Vec2::new(0.0, 1.0));
-    let d = [(p.x, -ex), (p.y, -ey), (w - p.x, ex), (h - p.y, ey)];
-    d.iter()
-        .min_by(|a, b| a.0.total_cmp(&b.0))
-        .map_or(Vec2::ZERO, |&(_, n)| n)
-}
-
 /// One piece of a closed contour between corners (or the whole contour),
 /// parameterized by normalized arc length.
 pub(super) struct Piece<'a> {
     pub(super) pts: Vec<Point>,
     /// Unit tangent at each vertex ([`Guide::Outline`] only, else empty).
-    tangents: Vec<Vec2>,
+    pub(super) tangents: Vec<Vec2>,
     /// Cumulative arc length at each vertex.
     pub(super) cum: Vec<f64>,
     pub(super) guide: Guide<'a>,
-    corner_start: bool,
-    corner_end: bool,
+    pub(super) corner_start: bool,
+    pub(super) corner_end: bool,
     /// The fitter sees coordinates relative to this point: kurbo's moment
     /// integrals lose precision far from the origin.
     pub(super) origin: Vec2,
     /// Prefix sums of the exact area and moment integrals of the polyline's
     /// segments (relative to `origin`), for [`Guide::Outline`]; empty for
     /// SDF contours, which keep kurbo's quadrature.
-    moments: Vec<[f64; 3]>,
+    pub(super) moments: Vec<[f64; 3]>,
     /// The segment [`Self::locate`] found last: the fitter samples a span
     /// in ascending arc length, so the next one is usually this or the one
     /// after (a hint only, the answer does not depend on it).
@@ -189,7 +171,7 @@ impl<'a> Piece<'a> {
     }
 
     /// The given tangents interpolated along segment `i` at arc length `s`.
-    fn given_tangent(&self, i: usize, s: f64) -> Option<Vec2> {
+    pub(super) fn given_tangent(&self, i: usize, s: f64) -> Option<Vec2> {
         let t0 = *self.tangents.get(i)?;
         let t1 = *self.tangents.get(i + 1)?;
         let seg = self.cum[i + 1] - self.cum[i];
@@ -248,12 +230,26 @@ impl<'a> Piece<'a> {
                     near
                 };
                 let mut cursor = lo;
+                // The last point found within `near` of segment `cursor`
+                // and how much further a point may be from it and still be
+                // (the triangle inequality): consecutive points of a curve
+                // mostly are, and need no search.
+                let mut anchor: Option<(Point, f64)> = None;
                 let mut pts = pts;
                 pts.all(|p| {
+                    if let Some((q, slack)) = anchor {
+                        let step = (p - q).hypot();
+                        if step <= slack {
+                            anchor = Some((p, slack - step));
+                            return true;
+                        }
+                    }
                     let (found, best) =
                         nearest_from(&self.pts, &self.cum, p, lo, cursor, hi, near, far);
+                    anchor = None;
                     if let Some(j) = found {
                         cursor = j;
+                        anchor = Some((p, near - best));
                     }
                     best <= near || best <= far && corridor.is_some_and(|c| c.reaches(p, limit))
                 })
@@ -263,8 +259,8 @@ impl<'a> Piece<'a> {
 
     /// Segment index and position at arc length `s` (clamped to the
     /// piece): the segment `i` with `cum[i] ≤ s < cum[i + 1]` (the last one
-    /// at the end), tried first at and after the last one found, then by
-    /// binary search.
+    /// at the end), tried first at the last one found, then by galloping
+    /// forwards or backwards from it.
     pub(super) fn locate(&self, s: f64) -> (usize, Point) {
         let n = self.pts.len();
         let s = s.clamp(0.0, self.length());
@@ -277,22 +273,39 @@ impl<'a> Piece<'a> {
             let ahead = self.cum.get(h + 1..).unwrap_or(&[]);
             (h + gallop(ahead, s)).min(n - 2)
         } else {
-            self.cum
-                .partition_point(|&c| c <= s)
-                .saturating_sub(1)
-                .min(n - 2)
+            // Behind it: gallop backwards (the next span starts where the
+            // last one did).
+            let behind = self.cum.get(..h).unwrap_or(&[]);
+            gallop_back_le(behind, s).saturating_sub(1).min(n - 2)
         };
         self.hint.set(i);
+        (i, self.point_on(i, s))
+    }
+
+    /// The point at arc length `s` (within the piece) on segment `i`.
+    fn point_on(&self, i: usize, s: f64) -> Point {
         let seg = self.cum[i + 1] - self.cum[i];
         let t = if seg > 0.0 {
             (s - self.cum[i]) / seg
         } else {
             0.0
         };
-        (i, self.pts[i].lerp(self.pts[i + 1], t))
+        self.pts[i].lerp(self.pts[i + 1], t)
     }
 
-    fn seg_dir(&self, i: usize) -> Vec2 {
+    /// [`Self::locate`] for arc lengths visited in ascending order: from
+    /// the segment `i` found for an earlier one, a step at a time.
+    pub(super) fn locate_after(&self, i: usize, s: f64) -> (usize, Point) {
+        let n = self.pts.len();
+        let s = s.clamp(0.0, self.length());
+        let mut i = i.min(n - 2);
+        while i + 2 < n && self.cum[i + 1] <= s {
+            i += 1;
+        }
+        (i, self.point_on(i, s))
+    }
+
+    pub(super) fn seg_dir(&self, i: usize) -> Vec2 {
         let d = self.pts[i + 1] - self.pts[i];
         let l = d.hypot();
         if l > 0.0 {
@@ -304,7 +317,7 @@ impl<'a> Piece<'a> {
 
     /// Chord direction over about a pixel from arc length `s` towards the
     /// interior of the piece (`forward` from the start, else backwards).
-    fn chord_dir(&self, s: f64, forward: bool) -> Vec2 {
+    pub(super) fn chord_dir(&self, s: f64, forward: bool) -> Vec2 {
         let len = self.length();
         let reach = 1.0f64.min(len);
         let (a, b) = if forward {
@@ -320,151 +333,6 @@ impl<'a> Piece<'a> {
             self.seg_dir(0)
         }
     }
-}
-
-impl ParamCurveFit for Piece<'_> {
-    fn sample_pt_tangent(&self, t: f64, sign: f64) -> CurveFitSample {
-        let s = t * self.length();
-        let (i, p) = self.locate(s);
-        let travel = self.seg_dir(i);
-        let at_start = t <= 0.0;
-        let at_end = t >= 1.0;
-        let len = self.length();
-        let near_start = self.corner_start && s < CORNER_REACH;
-        let near_end = self.corner_end && len - s < CORNER_REACH;
-        let given = match self.guide {
-            Guide::Outline(_) => self.given_tangent(i, s),
-            Guide::Field(_) => None,
-        };
-        let tangent = if (at_start && self.corner_start) || (at_end && self.corner_end) {
-            // At a corner the gradient is undefined: use the side's chord.
-            self.chord_dir(s, at_start || sign > 0.0 && !at_end)
-        } else if let Some(t) = given {
-            t
-        } else if near_start || near_end {
-            // Near a convex corner the distance field rounds off (its
-            // gradient points at the corner), so the polygon's own
-            // direction is the better tangent there.
-            self.chord_dir(s, near_start)
-        } else if let Guide::Field(sdf) = self.guide {
-            let g = clipped_gradient(sdf, p);
-            let perp = Vec2::new(-g.y, g.x);
-            let l = perp.hypot();
-            if l > 1e-6 {
-                let d = perp / l;
-                if d.dot(travel) < 0.0 {
-                    -d
-                } else {
-                    d
-                }
-            } else {
-                travel
-            }
-        } else {
-            travel
-        };
-        CurveFitSample {
-            p: p - self.origin,
-            tangent,
-        }
-    }
-
-    fn sample_pt_deriv(&self, t: f64) -> (Point, Vec2) {
-        let s = t * self.length();
-        let (i, p) = self.locate(s);
-        (p - self.origin, self.seg_dir(i) * self.length())
-    }
-
-    fn moment_integrals(&self, range: Range<f64>) -> (f64, f64, f64) {
-        if self.moments.len() != self.pts.len() {
-            return self.quadrature_moments(range);
-        }
-        // Exact: the integrals of y dx, x y dx and y² dx over the polyline,
-        // partial segments at both ends and prefix sums between.
-        let len = self.length();
-        let (i0, p0) = self.locate(range.start * len);
-        let (i1, p1) = self.locate(range.end * len);
-        let o = self.origin;
-        let m = if i0 == i1 {
-            segment_moments(p0 - o, p1 - o)
-        } else {
-            let a = segment_moments(p0 - o, self.pts[i0 + 1] - o);
-            let b = segment_moments(self.pts[i1] - o, p1 - o);
-            let (lo, hi) = (self.moments[i0 + 1], self.moments[i1]);
-            [0, 1, 2].map(|k| a[k] + (hi[k] - lo[k]) + b[k])
-        };
-        (m[0], m[1], m[2])
-    }
-
-    fn break_cusp(&self, _range: Range<f64>) -> Option<f64> {
-        // Corners were cut before fitting.
-        None
-    }
-}
-
-impl Piece<'_> {
-    /// Position (px) and unit tangent at `t` (a share of the length) for
-    /// each of [`FIT_SAMPLES`] points evenly spread over `range`, where
-    /// kurbo's fitter samples them.
-    pub(super) fn samples(&self, range: Range<f64>) -> [(Point, Vec2); FIT_SAMPLES] {
-        let step = (range.end - range.start) / (FIT_SAMPLES - 1) as f64;
-        let mut out = [(Point::ORIGIN, Vec2::ZERO); FIT_SAMPLES];
-        for (i, o) in out.iter_mut().enumerate() {
-            let s = self.sample_pt_tangent(range.start + i as f64 * step, 1.0);
-            *o = (s.p + self.origin, s.tangent);
-        }
-        out
-    }
-
-    /// Position (px) and unit tangent at the start (`at_start`) or end of
-    /// a span at `t`, the tangents the span's cubic takes there.
-    pub(super) fn end_sample(&self, t: f64, at_start: bool) -> (Point, Vec2) {
-        let s = self.sample_pt_tangent(t, if at_start { 1.0 } else { -1.0 });
-        let l = s.tangent.hypot();
-        let tan = if l > 1e-12 { s.tangent / l } else { s.tangent };
-        (s.p + self.origin, tan)
-    }
-
-    /// Signed area `∫ y dx` and moments `∫ x y dx`, `½ ∫ y² dx` (px², px³)
-    /// of the closed loop made of the outline over `range` and the chord
-    /// back from `p3` to `p0`, about `p0` (the integrals of a closed loop
-    /// shift with the origin by the area times the shift).
-    pub(super) fn span_moments(&self, range: Range<f64>, p0: Point, p3: Point) -> [f64; 3] {
-        let o = self.origin;
-        let (a, x, y) = self.moment_integrals(range);
-        let c = segment_moments(p0 - o, p3 - o);
-        let (a, x, y) = (a - c[0], x - c[1], y - c[2]);
-        let q = p0 - o;
-        [a, x - q.x * a, 0.5 * y - q.y * a]
-    }
-
-    /// kurbo's default moment integrals (16-point Gauss–Legendre on the
-    /// derivative), kept for SDF contours so their output does not change.
-    fn quadrature_moments(&self, range: Range<f64>) -> (f64, f64, f64) {
-        let t0 = 0.5 * (range.start + range.end);
-        let dt = 0.5 * (range.end - range.start);
-        let (mut a, mut x, mut y) = (0.0, 0.0, 0.0);
-        for &(wi, xi) in kurbo::common::GAUSS_LEGENDRE_COEFFS_16 {
-            let (p, d) = self.sample_pt_deriv(t0 + xi * dt);
-            let ai = wi * d.x * p.y;
-            a += ai;
-            x += p.x * ai;
-            y += p.y * ai;
-        }
-        (a * dt, x * dt, y * dt)
-    }
-}
-
-/// The integrals ∫ y dx, ∫ x y dx and ∫ y² dx along the straight segment
-/// from `a` to `b` (what kurbo's fitter matches: signed area and its first
-/// moments, kurbo `ParamCurveFit::moment_integrals`).
-fn segment_moments(a: Point, b: Point) -> [f64; 3] {
-    let d = b - a;
-    [
-        d.x * (a.y + 0.5 * d.y),
-        d.x * (a.x * a.y + 0.5 * (a.x * d.y + a.y * d.x) + d.x * d.y / 3.0),
-        d.x * (a.y * a.y + a.y * d.y + d.y * d.y / 3.0),
-    ]
 }
 
 /// Fits a closed contour (pixel coordinates) of `sdf`'s zero level set with
@@ -643,6 +511,28 @@ mod tests {
                 ((x as f64 + 0.5 - cx).hypot(y as f64 + 0.5 - cy) - r) as f32
             }),
             to_user: Affine::IDENTITY,
+        }
+    }
+
+    proptest::proptest! {
+        /// Stepping on from an earlier arc length's segment finds what a
+        /// search from scratch does (zero-length segments included).
+        #[test]
+        fn locate_after_agrees_with_locate(
+            gaps in proptest::collection::vec(proptest::sample::select(vec![0.0, 0.3, 1.0, 2.5]), 1..30),
+            a in 0.0f64..1.1,
+            b in 0.0f64..1.1,
+        ) {
+            let mut pts = vec![Point::new(3.0, 4.0)];
+            for (k, g) in gaps.iter().enumerate() {
+                let last = pts[pts.len() - 1];
+                pts.push(last + Vec2::new(*g, 0.1 * (k % 3) as f64 * g));
+            }
+            let piece = Piece::new(pts, Vec::new(), Guide::Outline(None), false, false);
+            let len = piece.length();
+            let (s1, s2) = (a.min(b) * len, a.max(b) * len);
+            let (j, _) = piece.locate(s1);
+            proptest::prop_assert_eq!(piece.locate_after(j, s2), piece.locate(s2));
         }
     }
 

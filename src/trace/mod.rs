@@ -16,6 +16,7 @@ pub mod cover;
 mod direct;
 pub mod fit;
 mod nearest;
+mod sample;
 mod span;
 
 use crate::error::{Error, Result};
@@ -171,38 +172,44 @@ pub fn trace_outline(
     opts: &TraceOptions,
 ) -> Vec<BezPath> {
     let polys: Vec<&[Point]> = loops.iter().map(|l| l.points.as_slice()).collect();
-    let islands = nest_polygons(&polys, opts.min_area);
     // Every loop is fitted on its own (in parallel: one island can hold
-    // most of the work), then the islands are assembled in order, so the
-    // output does not depend on the thread count.
-    let order: Vec<usize> = islands
-        .iter()
-        .flat_map(|(outer, holes)| std::iter::once(*outer).chain(holes.iter().copied()))
-        .collect();
-    let fitted: Vec<BezPath> = order
-        .par_iter()
-        .map(|&i| {
-            let mut path = BezPath::new();
-            if let Some(l) = loops.get(i) {
-                cover::fit_outline(
-                    &l.points,
-                    &l.tangents,
-                    &l.corners,
-                    opts.tolerance,
-                    corridor,
-                    &mut path,
-                );
-            }
-            path
-        })
-        .collect();
-    let mut fitted = fitted.into_iter();
+    // most of the work) while the loops are nested, then the islands are
+    // assembled in order, so the output does not depend on the thread
+    // count. Loops too small to keep are skipped by their area (nesting
+    // drops them by the same measure); the rare hole nesting finds no
+    // outer for is fitted for nothing.
+    let (islands, mut fitted) = rayon::join(
+        || nest_polygons(&polys, opts.min_area),
+        || {
+            loops
+                .par_iter()
+                .map(|l| {
+                    let mut path = BezPath::new();
+                    let big = !l.points.is_empty()
+                        && contour::signed_area(&l.points).abs() >= opts.min_area;
+                    if big {
+                        cover::fit_outline(
+                            &l.points,
+                            &l.tangents,
+                            &l.corners,
+                            opts.tolerance,
+                            corridor,
+                            &mut path,
+                        );
+                    }
+                    Some(path)
+                })
+                .collect::<Vec<Option<BezPath>>>()
+        },
+    );
     islands
         .iter()
-        .map(|(_, holes)| {
+        .map(|(outer, holes)| {
             let mut path = BezPath::new();
-            for p in fitted.by_ref().take(1 + holes.len()) {
-                path.extend(p);
+            for &i in std::iter::once(outer).chain(holes) {
+                if let Some(p) = fitted.get_mut(i).and_then(Option::take) {
+                    path.extend(p);
+                }
             }
             path
         })

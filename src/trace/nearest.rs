@@ -34,15 +34,20 @@ pub(super) fn nearest_segment(
     let mut bound = far;
     let mut j = from;
     while j <= to && j < pts.len().saturating_sub(1) {
-        let reach = (p - pts[j]).hypot() - bound - MARGIN;
-        if reach > 0.0 {
+        // Squared first: most points are within the bound of the vertex.
+        let v2 = (p - pts[j]).hypot2();
+        let r = bound + MARGIN;
+        if v2 > r * r {
+            let reach = v2.sqrt() - r;
             // Skip the segments ending less than `reach` further on
-            // (`cum` ascends).
+            // (`cum` ascends); none when segment j itself reaches that far.
             let target = cum[j] + reach;
-            let skip = cum.get(j + 1..to + 2).map_or(0, |c| gallop(c, target));
-            if skip > 0 {
-                j += skip;
-                continue;
+            if cum.get(j + 1).is_some_and(|&c| c < target) {
+                let skip = cum.get(j + 1..to + 2).map_or(0, |c| gallop(c, target));
+                if skip > 0 {
+                    j += skip;
+                    continue;
+                }
             }
         }
         let d = crate::raster::sdf::point_segment_distance(p, kurbo::Line::new(pts[j], pts[j + 1]));
@@ -96,6 +101,24 @@ pub(super) fn gallop_le(c: &[f64], target: f64) -> usize {
     gallop_while(c, |x| x <= target)
 }
 
+/// The number of values of ascending `c` at or below `target`, by
+/// doubling steps back from the end and then bisecting: `locate` steps
+/// back a span's length now and then.
+pub(super) fn gallop_back_le(c: &[f64], target: f64) -> usize {
+    let n = c.len();
+    // Find a window `n - hi .. n - lo` whose first value is at or below
+    // `target` (or the start) and whose later values are above it.
+    let (mut lo, mut hi) = (0usize, 1usize);
+    while hi <= n && c[n - hi] > target {
+        lo = hi;
+        hi *= 2;
+    }
+    let start = n.saturating_sub(hi);
+    start
+        + c.get(start..n - lo)
+            .map_or(0, |w| w.partition_point(|&x| x <= target))
+}
+
 /// The length of the leading run of `c` where `ahead` holds (`c` ascends,
 /// so it holds on a prefix): doubling steps, then bisection.
 fn gallop_while(c: &[f64], ahead: impl Fn(f64) -> bool) -> usize {
@@ -125,6 +148,7 @@ mod tests {
             c.sort_by(|a, b| a.total_cmp(b));
             prop_assert_eq!(gallop(&c, t), c.partition_point(|&x| x < t));
             prop_assert_eq!(gallop_le(&c, t), c.partition_point(|&x| x <= t));
+            prop_assert_eq!(gallop_back_le(&c, t), c.partition_point(|&x| x <= t));
         }
 
         /// The segment search with skips by arc length answers as a scan

@@ -102,13 +102,29 @@ pub(super) fn fit_span(piece: &Piece, range: Range<f64>, accuracy: f64) -> Optio
         // The vertices strictly inside (s0, s1): `cum` ascends.
         let lo = piece.cum.partition_point(|&c| c <= s0);
         let hi = piece.cum.partition_point(|&c| c < s1).max(lo);
-        let within = piece.pts[lo..hi].iter().all(|&p| {
+        let inner = piece.pts.get(lo..hi).unwrap_or(&[]);
+        let near_chord = |&p: &Point| {
             crate::raster::sdf::point_segment_distance(p, chord)
                 <= piece.reach(CHORD_SHARE * accuracy)
-        });
+        };
+        // Every eighth vertex first: a curved span strays from its chord
+        // mid-way, and most spans reaching here are curved.
+        let stride = (inner.len() / 8).max(1);
+        let within = inner
+            .iter()
+            .skip(stride / 2)
+            .step_by(stride)
+            .all(near_chord)
+            && inner.iter().all(near_chord);
         let on_level_set = || {
+            // On an outline, as a cubic's (see `super::direct`): at most
+            // 0.4 px apart.
+            let m = match piece.guide {
+                Guide::Outline(_) => (((b - a).hypot() / 0.4).ceil() as usize).clamp(16, 64),
+                Guide::Field(_) => 64,
+            };
             piece.holds(
-                (1..64).map(|k| a.lerp(b, k as f64 / 64.0)),
+                (1..m).map(|k| a.lerp(b, k as f64 / m as f64)),
                 s0,
                 s1,
                 CHORD_SHARE * accuracy,
@@ -191,12 +207,9 @@ pub(super) const MIN_SPAN_PX: f64 = 1.5;
 /// kurbo's fitter, with the curve also within `accuracy` + [`CHECK_SLACK`]
 /// of the SDF's zero level at 63 points. Either way the curve may not loop
 /// away (arc length at most 1.5× the source's) and the range must not be
-/// "spicy" (see [`is_spicy`]).
+/// "spicy" (see [`is_sharp`]).
 fn fit_checked(piece: &Piece, range: Range<f64>, accuracy: f64) -> Option<CubicBez> {
-    let samples = piece.samples(range.clone());
-    if is_spicy(&samples) {
-        return None;
-    }
+    let samples = piece.samples_while(range.clone(), |a, b| !is_sharp(a, b))?;
     if let Guide::Outline(_) = piece.guide {
         return super::direct::fit_span_direct(piece, range, &samples, accuracy);
     }
@@ -215,15 +228,13 @@ fn fit_checked(piece: &Piece, range: Range<f64>, accuracy: f64) -> Option<CubicB
 /// measure samples 20 interior points, so does [`super::direct`].
 pub(super) const FIT_SAMPLES: usize = 22;
 
-/// True when kurbo would judge the range "spicy" (tangents of neighbouring
-/// error samples more than about 11° apart) and fall back to measuring
+/// True when kurbo would judge a range "spicy" for these tangents of
+/// neighbouring error samples (more than about 11° apart) and fall back to measuring
 /// error by arc length at 1e-9 accuracy, which is very slow; such ranges
 /// are split first. The outline path keeps the same limit on how sharply
 /// one cubic's source may bend between samples.
-fn is_spicy(samples: &[(Point, Vec2); FIT_SAMPLES]) -> bool {
-    samples
-        .windows(2)
-        .any(|w| w[1].1.cross(w[0].1).abs() > 0.2 * w[1].1.dot(w[0].1).abs())
+fn is_sharp(a: Vec2, b: Vec2) -> bool {
+    b.cross(a).abs() > 0.2 * b.dot(a).abs()
 }
 
 #[cfg(test)]
