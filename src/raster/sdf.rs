@@ -318,14 +318,14 @@ fn edge_model(cov: &Coverage, x: i32, y: i32) -> Option<EdgeModel> {
 /// Where the outline crosses link `l` (first end inside, or second end
 /// inside), as a fraction from its first end, and whether coverage informed
 /// the estimate.
-fn link_crossing(cov: &Coverage, l: Link, thin_runs: bool) -> (f64, bool) {
+fn link_crossing(cov: &Coverage, l: Link, thin: Option<&Grid<bool>>) -> (f64, bool) {
     let ((x0, y0), (x1, y1)) = l.ends();
     let (w, h) = (cov.width() as i32, cov.height() as i32);
     let off = |x: i32, y: i32| x < 0 || y < 0 || x >= w || y >= h;
     if off(x0, y0) || off(x1, y1) {
         return (0.5, true);
     }
-    if let Some(t) = thin_run_crossing(cov, l).filter(|_| thin_runs) {
+    if let Some(t) = thin.and_then(|inside| thin_run_crossing(cov, inside, l)) {
         return (clamp_t(t), true);
     }
     let e = l.direction();
@@ -371,7 +371,7 @@ const THIN_RUN: i32 = 3;
 /// interval reaches: `[first + ½ − c_first, last − ½ + c_last]`, so the
 /// interval holds exactly the run's ink. Returns the fraction of the link
 /// from its first end, or `None` when the link is not across a thin run.
-fn thin_run_crossing(cov: &Coverage, l: Link) -> Option<f64> {
+fn thin_run_crossing(cov: &Coverage, inside: &Grid<bool>, l: Link) -> Option<f64> {
     let ((x0, y0), _) = l.ends();
     let (dx, dy) = if l.horizontal { (1, 0) } else { (0, 1) };
     let (w, h) = (cov.width() as i32, cov.height() as i32);
@@ -382,10 +382,12 @@ fn thin_run_crossing(cov: &Coverage, l: Link) -> Option<f64> {
         (x >= 0 && y >= 0 && x < w && y < h).then(|| cov.get(x as usize, y as usize))
     };
     let inked = |c: f32| c > COVERAGE_EPS;
-    let c0 = at(0)?;
-    let c1 = at(1)?;
+    // Both ends on the canvas.
+    at(0)?;
+    at(1)?;
     // The inside end is inked; the run spreads from it both ways.
-    let (mut first, mut last) = if c0 >= 0.5 { (0, 0) } else { (1, 1) };
+    let in0 = inside.get_or(x0 as isize, y0 as isize, false);
+    let (mut first, mut last) = if in0 { (0, 0) } else { (1, 1) };
     while last - first < THIN_RUN {
         match at(last + 1) {
             Some(c) if inked(c) => last += 1,
@@ -414,7 +416,56 @@ fn thin_run_crossing(cov: &Coverage, l: Link) -> Option<f64> {
     };
     // Ink up to hi and paper after when the first end is inside; else the
     // crossing is where the ink starts.
-    Some(if c0 >= 0.5 && c1 < 0.5 { hi } else { lo })
+    Some(if in0 { hi } else { lo })
+}
+
+/// The ink (px) of the thin runs pixel `(x, y)` lies in (the most over
+/// the two pixel axes; a run of at most [`THIN_RUN`] inked pixels between
+/// paper), and whether it is a ridge: it carries a thin line no pixel of
+/// which is half covered, the run's ink being at least one half and this
+/// its most covered pixel (the first of equals). A 1-px line straddling
+/// two rows at 8-bit precision covers each 127/255: thresholded at one
+/// half it vanishes, and a wave drawn with it breaks at every trough. A
+/// ridge counts as ink, and [`thin_run_crossing`] then places the line's
+/// edges by its run's ink.
+fn thin_mass(cov: &Coverage, x: i32, y: i32) -> (f32, bool) {
+    let (w, h) = (cov.width() as i32, cov.height() as i32);
+    let at = |x: i32, y: i32| -> f32 {
+        if x >= 0 && y >= 0 && x < w && y < h {
+            cov.get(x as usize, y as usize)
+        } else {
+            0.0
+        }
+    };
+    let c = at(x, y);
+    if c <= COVERAGE_EPS {
+        return (0.0, false);
+    }
+    let (mut best, mut ridge) = (0.0f32, false);
+    for (dx, dy) in [(1, 0), (0, 1)] {
+        let inked = |j: i32| at(x + j * dx, y + j * dy) > COVERAGE_EPS;
+        let (mut first, mut last) = (0, 0);
+        while last - first < THIN_RUN && inked(last + 1) {
+            last += 1;
+        }
+        while last - first < THIN_RUN && inked(first - 1) {
+            first -= 1;
+        }
+        if last - first >= THIN_RUN || inked(last + 1) || inked(first - 1) {
+            continue;
+        }
+        let run: Vec<f32> = (first..=last).map(|j| at(x + j * dx, y + j * dy)).collect();
+        let most = run.iter().copied().fold(0.0f32, f32::max);
+        let mass: f32 = run.iter().sum();
+        best = best.max(mass);
+        // This pixel is the first of the most covered.
+        let first_most = run
+            .iter()
+            .position(|&v| v == most)
+            .map(|k| k as i32 + first);
+        ridge |= most < 0.5 && mass >= 0.5 && first_most == Some(0);
+    }
+    (best, ridge)
 }
 
 /// Rounds of constrained smoothing for vertices that coverage did not place.
@@ -435,13 +486,25 @@ pub fn subpixel_outline(cov: &Coverage) -> Vec<Vec<Point>> {
 /// ≥ 0.95 to 0.83 regular gaps (`tests/fill.rs`); the styles were tuned on
 /// the single-edge reading, and that change needs its own look.
 fn outline_polygons(cov: &Coverage, thin_runs: bool) -> Vec<Vec<Point>> {
-    let values = cov.map(|c| {
-        if c >= 0.5 {
-            (0.5 - c).min(-1e-6)
+    // Marching squares on 0.5 − coverage, inside where negative; reading
+    // thin runs, a pixel of a thin line counts as covered by its run's
+    // whole ink (so a ridge pixel is inside, and the two pixels of a
+    // diagonal step of a hairline join at their saddle).
+    let values = Grid::from_fn(cov.width(), cov.height(), |x, y| {
+        let c = cov.get(x, y);
+        let (mass, ridge) = if thin_runs {
+            thin_mass(cov, x as i32, y as i32)
+        } else {
+            (0.0, false)
+        };
+        if c >= 0.5 || ridge {
+            -(c.max(mass) - 0.5).max(1e-6)
         } else {
             0.5 - c
         }
     });
+    let inside = values.map(|v| v < 0.0);
+    let thin = thin_runs.then_some(&inside);
     let contours = contour::extract(&values);
     contours
         .par_iter()
@@ -449,7 +512,7 @@ fn outline_polygons(cov: &Coverage, thin_runs: bool) -> Vec<Vec<Point>> {
             let est: Vec<(f64, bool)> = c
                 .links
                 .iter()
-                .map(|&l| link_crossing(cov, l, thin_runs))
+                .map(|&l| link_crossing(cov, l, thin))
                 .collect();
             let mut t: Vec<f64> = est.iter().map(|e| e.0).collect();
             let n = t.len();
@@ -720,5 +783,37 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A 1-px line straddling two rows at 8-bit precision (127/255 =
+    /// 0.498 each, so neither pixel is half covered) is still a line: one
+    /// loop with its edges on the rows' outer halves; and the same line
+    /// stepping down a row halfway stays one loop (the diagonal step of a
+    /// hairline joins at its saddle).
+    #[test]
+    fn a_hairline_under_half_coverage_stays_whole() {
+        let c = 1.0 - 128.0 / 255.0;
+        let straight = Grid::from_fn(40, 16, |x, y| {
+            if (4..36).contains(&x) && (y == 6 || y == 7) {
+                c
+            } else {
+                0.0
+            }
+        });
+        let loops = subpixel_outline(&straight);
+        assert_eq!(loops.len(), 1);
+        for p in loops[0].iter().filter(|p| (8.0..32.0).contains(&p.x)) {
+            let d = (p.y - 6.5).abs().min((p.y - 7.5).abs());
+            assert!(d < 0.05, "{p:?}");
+        }
+        let stepped = Grid::from_fn(40, 16, |x, y| {
+            let top = if x < 20 { 6 } else { 7 };
+            if (4..36).contains(&x) && (y == top || y == top + 1) {
+                c
+            } else {
+                0.0
+            }
+        });
+        assert_eq!(subpixel_outline(&stepped).len(), 1);
     }
 }
