@@ -372,51 +372,48 @@ const THIN_RUN: i32 = 3;
 /// interval holds exactly the run's ink. Returns the fraction of the link
 /// from its first end, or `None` when the link is not across a thin run.
 fn thin_run_crossing(cov: &Coverage, inside: &Grid<bool>, l: Link) -> Option<f64> {
-    let ((x0, y0), _) = l.ends();
+    let ((x0, y0), (x1, y1)) = l.ends();
     let (dx, dy) = if l.horizontal { (1, 0) } else { (0, 1) };
-    let (w, h) = (cov.width() as i32, cov.height() as i32);
-    // Coverage at step j along the axis from the first end (None off the
-    // canvas: a run against the border is not bounded by paper).
-    let at = |j: i32| -> Option<f32> {
-        let (x, y) = (x0 + j * dx, y0 + j * dy);
-        (x >= 0 && y >= 0 && x < w && y < h).then(|| cov.get(x as usize, y as usize))
-    };
-    let inked = |c: f32| c > COVERAGE_EPS;
-    // Both ends on the canvas.
-    at(0)?;
-    at(1)?;
-    // The inside end is inked; the run spreads from it both ways.
+    // The run through the inside end; steps counted from the first end.
     let in0 = inside.get_or(x0 as isize, y0 as isize, false);
-    let (mut first, mut last) = if in0 { (0, 0) } else { (1, 1) };
-    while last - first < THIN_RUN {
-        match at(last + 1) {
-            Some(c) if inked(c) => last += 1,
-            Some(_) => break,
-            None => return None,
-        }
-    }
-    while last - first < THIN_RUN {
-        match at(first - 1) {
-            Some(c) if inked(c) => first -= 1,
-            Some(_) => break,
-            None => return None,
-        }
-    }
-    // Bounded by paper both ways, and short.
-    if last - first >= THIN_RUN || inked(at(last + 1)?) || inked(at(first - 1)?) {
-        return None;
-    }
-    let c_first = f64::from(at(first)?);
-    let c_last = f64::from(at(last)?);
+    let (x, y, shift) = if in0 { (x0, y0, 0) } else { (x1, y1, 1) };
+    let (first, last) = thin_run(cov, x, y, dx, dy)?;
+    let c_first = f64::from(coverage_at(cov, x + first * dx, y + first * dy));
+    let c_last = f64::from(coverage_at(cov, x + last * dx, y + last * dy));
+    let (first, last) = (f64::from(first + shift), f64::from(last + shift));
     let (lo, hi) = if first == last {
         // One pixel: the interval is centred on it.
-        (first as f64 - 0.5 * c_first, first as f64 + 0.5 * c_first)
+        (first - 0.5 * c_first, first + 0.5 * c_first)
     } else {
-        (first as f64 + 0.5 - c_first, last as f64 - 0.5 + c_last)
+        (first + 0.5 - c_first, last - 0.5 + c_last)
     };
     // Ink up to hi and paper after when the first end is inside; else the
     // crossing is where the ink starts.
     Some(if in0 { hi } else { lo })
+}
+
+/// Coverage of pixel `(x, y)`, paper outside the grid.
+fn coverage_at(cov: &Coverage, x: i32, y: i32) -> f32 {
+    cov.get_or(x as isize, y as isize, 0.0)
+}
+
+/// The run of inked pixels along the axis `(dx, dy)` through pixel
+/// `(x, y)`, as steps from it `(first ≤ 0, last ≥ 0)`, when it is thin: at
+/// most [`THIN_RUN`] pixels, paper (or the outside of the grid) at both
+/// ends.
+fn thin_run(cov: &Coverage, x: i32, y: i32, dx: i32, dy: i32) -> Option<(i32, i32)> {
+    let inked = |j: i32| coverage_at(cov, x + j * dx, y + j * dy) > COVERAGE_EPS;
+    if !inked(0) {
+        return None;
+    }
+    let (mut first, mut last) = (0, 0);
+    while last - first < THIN_RUN && inked(last + 1) {
+        last += 1;
+    }
+    while last - first < THIN_RUN && inked(first - 1) {
+        first -= 1;
+    }
+    (last - first < THIN_RUN && !inked(last + 1) && !inked(first - 1)).then_some((first, last))
 }
 
 /// The ink (px) of the thin runs pixel `(x, y)` lies in (the most over
@@ -429,32 +426,14 @@ fn thin_run_crossing(cov: &Coverage, inside: &Grid<bool>, l: Link) -> Option<f64
 /// ridge counts as ink, and [`thin_run_crossing`] then places the line's
 /// edges by its run's ink.
 fn thin_mass(cov: &Coverage, x: i32, y: i32) -> (f32, bool) {
-    let (w, h) = (cov.width() as i32, cov.height() as i32);
-    let at = |x: i32, y: i32| -> f32 {
-        if x >= 0 && y >= 0 && x < w && y < h {
-            cov.get(x as usize, y as usize)
-        } else {
-            0.0
-        }
-    };
-    let c = at(x, y);
-    if c <= COVERAGE_EPS {
-        return (0.0, false);
-    }
     let (mut best, mut ridge) = (0.0f32, false);
     for (dx, dy) in [(1, 0), (0, 1)] {
-        let inked = |j: i32| at(x + j * dx, y + j * dy) > COVERAGE_EPS;
-        let (mut first, mut last) = (0, 0);
-        while last - first < THIN_RUN && inked(last + 1) {
-            last += 1;
-        }
-        while last - first < THIN_RUN && inked(first - 1) {
-            first -= 1;
-        }
-        if last - first >= THIN_RUN || inked(last + 1) || inked(first - 1) {
+        let Some((first, last)) = thin_run(cov, x, y, dx, dy) else {
             continue;
-        }
-        let run: Vec<f32> = (first..=last).map(|j| at(x + j * dx, y + j * dy)).collect();
+        };
+        let run: Vec<f32> = (first..=last)
+            .map(|j| coverage_at(cov, x + j * dx, y + j * dy))
+            .collect();
         let most = run.iter().copied().fold(0.0f32, f32::max);
         let mass: f32 = run.iter().sum();
         best = best.max(mass);
