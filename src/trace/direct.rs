@@ -251,11 +251,17 @@ struct CurvePoints {
     m: usize,
 }
 
+/// How many chords a curve of (at most) `length` px is checked along:
+/// chords of about [`CURVE_SPACING`] px, between [`MIN_CURVE_POINTS`] and
+/// [`CURVE_POINTS`] of them (a NaN length casts to 0: the fewest).
+pub(super) fn check_chords(length: f64) -> usize {
+    ((length / CURVE_SPACING).ceil() as usize).clamp(MIN_CURVE_POINTS, CURVE_POINTS)
+}
+
 impl CurvePoints {
     fn new(c: &CubicBez) -> Self {
         let polygon = (c.p1 - c.p0).hypot() + (c.p2 - c.p1).hypot() + (c.p3 - c.p2).hypot();
-        // A NaN length casts to 0: the fewest chords.
-        let m = ((polygon / CURVE_SPACING).ceil() as usize).clamp(MIN_CURVE_POINTS, CURVE_POINTS);
+        let m = check_chords(polygon);
         let mut pts = [Point::ORIGIN; CURVE_POINTS + 1];
         let mut cum = [0.0; CURVE_POINTS + 1];
         for k in 0..=m {

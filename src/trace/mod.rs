@@ -197,9 +197,9 @@ pub fn trace_outline(
                             &mut path,
                         );
                     }
-                    Some(path)
+                    path
                 })
-                .collect::<Vec<Option<BezPath>>>()
+                .collect::<Vec<BezPath>>()
         },
     );
     islands
@@ -207,8 +207,8 @@ pub fn trace_outline(
         .map(|(outer, holes)| {
             let mut path = BezPath::new();
             for &i in std::iter::once(outer).chain(holes) {
-                if let Some(p) = fitted.get_mut(i).and_then(Option::take) {
-                    path.extend(p);
+                if let Some(p) = fitted.get_mut(i) {
+                    path.extend(std::mem::take(p));
                 }
             }
             path

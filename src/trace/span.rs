@@ -117,10 +117,9 @@ pub(super) fn fit_span(piece: &Piece, range: Range<f64>, accuracy: f64) -> Optio
             .all(near_chord)
             && inner.iter().all(near_chord);
         let on_level_set = || {
-            // On an outline, as a cubic's (see `super::direct`): at most
-            // 0.4 px apart.
+            // On an outline, as a cubic's (see `super::direct`).
             let m = match piece.guide {
-                Guide::Outline(_) => (((b - a).hypot() / 0.4).ceil() as usize).clamp(16, 64),
+                Guide::Outline(_) => super::direct::check_chords((b - a).hypot()),
                 Guide::Field(_) => 64,
             };
             piece.holds(
