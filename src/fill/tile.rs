@@ -289,7 +289,7 @@ pub fn periodic_sdf(d: &Grid<f32>) -> Grid<f32> {
     let cov = Grid::from_fn(3 * w, 3 * h, |x, y| {
         (0.5 - d.get(x % w, y % h)).clamp(0.0, 1.0)
     });
-    let sdf = Sdf::from_coverage(&cov, Affine::IDENTITY);
+    let sdf = Sdf::from_distance_ramp(&cov, Affine::IDENTITY);
     Grid::from_fn(w, h, |x, y| sdf.dist.get(x + w, y + h))
 }
 

@@ -93,10 +93,24 @@ impl Sdf {
     }
 
     /// The SDF of anti-aliased (or binary) coverage, with sub-pixel edges
-    /// recovered from the coverage values; see the module docs.
+    /// recovered from the coverage values, thin lines read as one interval
+    /// of ink across their run ([`subpixel_outline`]); see the module docs.
     pub fn from_coverage(cov: &Coverage, to_user: Affine) -> Sdf {
-        let inside = cov.map(|c| c >= 0.5);
-        let polygons = outline_polygons(cov, false);
+        Self::from_outline(cov, to_user, true)
+    }
+
+    /// The SDF of a clamped distance ramp `cov = clamp(½ − d, 0, 1)` (what
+    /// re-measuring an SDF through coverage gives): each link's edge read
+    /// on its own. Such a ramp is not an area, so the thin-run reading of
+    /// [`Sdf::from_coverage`], which sums a run's coverage into a line's
+    /// width, does not apply to it.
+    pub fn from_distance_ramp(cov: &Coverage, to_user: Affine) -> Sdf {
+        Self::from_outline(cov, to_user, false)
+    }
+
+    /// The SDF of [`outline_polygons`]' outline, signed by the same inside.
+    fn from_outline(cov: &Coverage, to_user: Affine, thin_runs: bool) -> Sdf {
+        let (inside, polygons) = outline_polygons(cov, thin_runs);
         let mut segments = Vec::new();
         for poly in &polygons {
             let n = poly.len();
@@ -455,16 +469,14 @@ const SMOOTHING_ROUNDS: usize = 12;
 /// of `cov ≥ 0.5`), placed by the edge model, or smoothed along its link
 /// where the coverage is binary.
 pub fn subpixel_outline(cov: &Coverage) -> Vec<Vec<Point>> {
-    outline_polygons(cov, true)
+    outline_polygons(cov, true).1
 }
 
+/// Which pixel centres are inside, and the closed polygons of
 /// [`subpixel_outline`], reading thin runs across links as thin lines
-/// ([`thin_run_crossing`]) when `thin_runs`. [`Sdf::from_coverage`] does
-/// not yet: the SDFs of style exemplars feed synthesis, and with thin runs
-/// read the knot fill's band continuity under a turning field fell from
-/// ≥ 0.95 to 0.83 regular gaps (`tests/fill.rs`); the styles were tuned on
-/// the single-edge reading, and that change needs its own look.
-fn outline_polygons(cov: &Coverage, thin_runs: bool) -> Vec<Vec<Point>> {
+/// ([`thin_run_crossing`]) when `thin_runs` (a ridge pixel of a hairline is
+/// then inside although its coverage is under one half).
+fn outline_polygons(cov: &Coverage, thin_runs: bool) -> (Grid<bool>, Vec<Vec<Point>>) {
     // Marching squares on 0.5 − coverage, inside where negative; reading
     // thin runs, a pixel of a thin line counts as covered by its run's
     // whole ink (so a ridge pixel is inside, and the two pixels of a
@@ -485,7 +497,7 @@ fn outline_polygons(cov: &Coverage, thin_runs: bool) -> Vec<Vec<Point>> {
     let inside = values.map(|v| v < 0.0);
     let thin = thin_runs.then_some(&inside);
     let contours = contour::extract(&values);
-    contours
+    let polygons = contours
         .par_iter()
         .map(|c| {
             let est: Vec<(f64, bool)> = c
@@ -514,7 +526,8 @@ fn outline_polygons(cov: &Coverage, thin_runs: bool) -> Vec<Vec<Point>> {
             }
             c.links.iter().zip(&t).map(|(l, &t)| l.point(t)).collect()
         })
-        .collect()
+        .collect();
+    (inside, polygons)
 }
 
 #[cfg(test)]
@@ -794,5 +807,37 @@ mod tests {
             }
         });
         assert_eq!(subpixel_outline(&stepped).len(), 1);
+        // The SDF keeps it: negative all along the line (the ridge pixels
+        // are inside, as the outline has them; read edge by edge, no pixel
+        // of it would be). Its zero level may still part at the step: the
+        // line's edges pass through the pixel centres there, and a field
+        // sampled at the centres cannot say more.
+        let sdf = Sdf::from_coverage(&stepped, Affine::IDENTITY);
+        for x in 5..35 {
+            let ink = (0..16).map(|y| sdf.dist.get(x, y)).fold(f32::MAX, f32::min);
+            assert!(ink < 0.0, "column {x}: nearest {ink}");
+        }
+    }
+
+    /// [`Sdf::from_distance_ramp`] reads a clamped distance as distance:
+    /// the ramp of a 1.5-px band's exact SDF gives the band back within a
+    /// tenth of a pixel.
+    #[test]
+    fn a_distance_ramp_gives_its_distance_back() {
+        let (top, bottom) = (6.3, 7.8);
+        let d = |y: f64| (top - y).max(y - bottom);
+        let ramp = Grid::from_fn(40, 16, |x, y| {
+            let yc = y as f64 + 0.5;
+            let dx = (4.0 - (x as f64 + 0.5)).max(x as f64 + 0.5 - 36.0);
+            (0.5 - d(yc).max(dx)).clamp(0.0, 1.0) as f32
+        });
+        let sdf = Sdf::from_distance_ramp(&ramp, Affine::IDENTITY);
+        for x in 8..32 {
+            for y in 4..10 {
+                let want = d(y as f64 + 0.5);
+                let got = f64::from(sdf.dist.get(x, y));
+                assert!((got - want).abs() < 0.1, "({x}, {y}): {got} vs {want}");
+            }
+        }
     }
 }

@@ -28,7 +28,7 @@ use std::path::{Path, PathBuf};
 
 /// Version of the analysis; bump it whenever the analysis or the cached
 /// types change so old caches are rebuilt.
-pub const ANALYSIS_VERSION: u32 = 4;
+pub const ANALYSIS_VERSION: u32 = 5;
 
 /// Environment variable naming the cache folder (below `--cache`).
 pub const CACHE_ENV: &str = "FLOURISH_CACHE_DIR";
