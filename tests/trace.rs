@@ -254,11 +254,13 @@ fn outline_curves_stay_within_tolerance_of_their_reference() {
     let slack = 0.05;
     for name in ["glyph-a-binary.png", "glyph-a.png", "holes.png"] {
         let path = root().join("samples/trace").join(name);
-        let Traceable::Outline(o) =
+        let Traceable::Outline(ink) =
             load_traceable(&path, &InputOptions::default()).expect("sample loads")
         else {
-            panic!("{name}: a one-layer bitmap is traced from its outline");
+            panic!("{name}: a bitmap is traced from its outline");
         };
+        assert_eq!(ink.layers.len(), 1, "{name}: one layer");
+        let o = &ink.layers[0];
         let segs: Vec<kurbo::Line> = o
             .loops
             .iter()
@@ -333,6 +335,22 @@ fn subpaths(paths: &[kurbo::BezPath]) -> Vec<kurbo::BezPath> {
 /// (each half covered) used to trace half as wide.
 #[test]
 fn hairlines_keep_their_weight() {
+    hairlines_keep_their_weight_with(&InputOptions::default());
+}
+
+/// The same with `--layers`: each quantized colour's coverage goes through
+/// `Sdf::from_coverage` and the contour tracer instead of the direct
+/// outline fit, and must read hairlines the same way (it broke the 1-px
+/// zigzag and the 1-px vertical line when it read each edge on its own).
+#[test]
+fn hairlines_keep_their_weight_in_layers() {
+    hairlines_keep_their_weight_with(&InputOptions {
+        layers: true,
+        ..InputOptions::default()
+    });
+}
+
+fn hairlines_keep_their_weight_with(input: &InputOptions) {
     use kurbo::Shape;
     let png = root().join("samples/trace/thin-lines.png");
     let svg = std::fs::read_to_string(root().join("samples/trace/thin-lines.svg")).expect("svg");
@@ -343,7 +361,7 @@ fn hairlines_keep_their_weight() {
         .map(|d| kurbo::BezPath::from_svg(d).expect("truth path"))
         .collect();
     let lines: Vec<kurbo::BezPath> = subpaths(&truth).into_iter().take(20).collect();
-    let doc = trace_file(&png, &InputOptions::default(), &TraceOptions::default()).expect("traces");
+    let doc = trace_file(&png, input, &TraceOptions::default()).expect("traces");
     let traced: Vec<kurbo::BezPath> = subpaths(
         &doc.groups
             .iter()

@@ -250,17 +250,33 @@ fn quantized_layers(
         .collect();
     let key =
         |c: &[f32; 3]| ((c[0] as u32 >> 4) << 8) | ((c[1] as u32 >> 4) << 4) | (c[2] as u32 >> 4);
-    let mut hist = std::collections::BTreeMap::<u32, (u64, [f64; 3])>::new();
-    for c in &rgb {
-        let e = hist.entry(key(c)).or_insert((0, [0.0; 3]));
+    let keys: Vec<u32> = rgb.iter().map(key).collect();
+    // Per colour bin: pixels, pixels inside a patch of the colour (their
+    // four neighbours in the same bin), and the sum of the colours.
+    let mut hist = std::collections::BTreeMap::<u32, (u64, u64, [f64; 3])>::new();
+    for (i, c) in rgb.iter().enumerate() {
+        let (x, y) = (i % w, i / w);
+        let k = keys[i];
+        let interior = x > 0
+            && y > 0
+            && x + 1 < w
+            && y + 1 < h
+            && [i - 1, i + 1, i - w, i + w].iter().all(|&j| keys[j] == k);
+        let e = hist.entry(k).or_insert((0, 0, [0.0; 3]));
         e.0 += 1;
-        for (sum, &v) in e.1.iter_mut().zip(c) {
+        e.1 += u64::from(interior);
+        for (sum, &v) in e.2.iter_mut().zip(c) {
             *sum += v as f64;
         }
     }
+    // A colour that only lines the edges of others (the greys of
+    // anti-aliasing between black ink and white paper) is a mix, not an
+    // ink: a palette colour must fill patches of its own.
+    let min_interior = ((w * h) as u64 / 2000).max(1);
     let mut bins: Vec<(u64, [f32; 3])> = hist
         .values()
-        .map(|(n, s)| (*n, [0, 1, 2].map(|k| (s[k] / *n as f64) as f32)))
+        .filter(|(_, interior, _)| *interior >= min_interior)
+        .map(|(n, _, s)| (*n, [0, 1, 2].map(|k| (s[k] / *n as f64) as f32)))
         .collect();
     bins.sort_by(|a, b| {
         b.0.cmp(&a.0)
@@ -436,5 +452,42 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Anti-aliasing greys are not inks: black hairlines and a black disc,
+    /// anti-aliased on white (thousands of pixels at a few grey levels),
+    /// give one black layer; a grey that fills a patch of its own is a
+    /// second layer.
+    #[test]
+    fn anti_aliasing_greys_make_no_layer_but_a_grey_patch_does() {
+        let (w, h) = (160usize, 120usize);
+        let picture = |grey_patch: bool| -> Vec<[u8; 4]> {
+            (0..w * h)
+                .map(|i| {
+                    let (x, y) = ((i % w) as f64 + 0.5, (i / w) as f64 + 0.5);
+                    // Hairlines 1 px wide straddling two rows: 50 % each.
+                    let line = (y % 8.0 - 4.0).abs() < 1.0 && x > 90.0;
+                    let d = (x - 45.0).hypot(y - 60.0) - 30.0;
+                    let disc = (0.5 - d).clamp(0.0, 1.0);
+                    let c = if line { 0.5 } else { disc };
+                    let v = if grey_patch && x > 100.0 && y < 40.0 {
+                        128
+                    } else {
+                        (255.0 * (1.0 - c)).round() as u8
+                    };
+                    [v, v, v, 255]
+                })
+                .collect()
+        };
+        let layers = quantized_layers(&picture(false), w, h, false, false);
+        assert_eq!(
+            layers.len(),
+            1,
+            "{:?}",
+            layers.iter().map(|l| l.0).collect::<Vec<_>>()
+        );
+        assert!(layers[0].0 == Color::rgb(0, 0, 0), "{:?}", layers[0].0);
+        let layers = quantized_layers(&picture(true), w, h, false, false);
+        assert_eq!(layers.len(), 2);
     }
 }

@@ -86,73 +86,102 @@ pub fn looks_like_svg(bytes: &[u8]) -> bool {
     t.starts_with('<') || bytes.starts_with(&[0x1f, 0x8b])
 }
 
-/// What `flourish trace` reads from a file: layers of ink with an SDF each,
-/// or, for a binary bitmap traced as one layer, the smooth outline it stands
-/// for (fitted directly; no SDF is built).
+/// What `flourish trace` reads from a file: for SVG input, layers of ink
+/// with an SDF each; for a raster, the outline of each layer's ink, fitted
+/// directly (no SDF is built).
 #[derive(Clone, Debug)]
 pub enum Traceable {
     /// Layers with signed distance fields.
     Field(Ink),
-    /// A binary bitmap's smooth outline.
+    /// A raster's outlines, one layer per ink colour.
     Outline(OutlineInk),
 }
 
-/// A binary bitmap read as its smooth outline (see [`super::binary`]).
+/// A raster read as the outlines of its ink layers: a binary layer's smooth
+/// outline (see [`super::binary`]), an anti-aliased layer's sub-pixel
+/// outline (see [`super::sdf::subpixel_outline`]).
 #[derive(Clone, Debug)]
 pub struct OutlineInk {
     /// Width in pixels.
     pub width: f64,
     /// Height in pixels.
     pub height: f64,
+    /// The layers, bottom first.
+    pub layers: Vec<OutlineLayer>,
+}
+
+/// One ink layer of an [`OutlineInk`].
+#[derive(Clone, Debug)]
+pub struct OutlineLayer {
     /// The ink's colour.
     pub color: Color,
     /// The outline's closed loops, in pixel coordinates.
     pub loops: Vec<super::binary::SmoothLoop>,
-    /// For a binary bitmap, where its edge may lie: curves fitted to the
+    /// For a binary layer, where its edge may lie: curves fitted to the
     /// loops may use this band instead of hugging them. None for an
-    /// anti-aliased bitmap, whose outline is known to a fraction of a pixel.
+    /// anti-aliased layer, whose outline is known to a fraction of a pixel.
     pub corridor: Option<super::corridor::Corridor>,
 }
 
-/// Reads `path` for tracing: like [`load`], except that a binary bitmap
-/// (traced as one layer) comes back as its smooth outline.
+impl OutlineLayer {
+    /// The layer of a binary bitmap's ink: its smooth outline, with the
+    /// corridor built alongside.
+    fn binary(color: Color, bits: &super::paths::Bitmap) -> OutlineLayer {
+        let (loops, corridor) = rayon::join(
+            || super::binary::bitmap_loops(bits),
+            || super::corridor::Corridor::from_bitmap(bits),
+        );
+        OutlineLayer {
+            color,
+            loops,
+            corridor: Some(corridor),
+        }
+    }
+
+    /// The layer of fractional coverage `cov`: its sub-pixel outline, or
+    /// the smooth outline when every value is 0 or 1 (a binary layer of a
+    /// colour raster).
+    fn coverage(color: Color, cov: &super::Coverage) -> OutlineLayer {
+        if super::binary::is_binary(cov) {
+            return Self::binary(color, &super::paths::Bitmap::from_coverage(cov));
+        }
+        OutlineLayer {
+            color,
+            loops: super::sdf::subpixel_outline(cov)
+                .into_par_iter()
+                .filter(|p| p.len() >= 3)
+                .map(super::binary::polygon_loop)
+                .collect(),
+            corridor: None,
+        }
+    }
+}
+
+/// Reads `path` for tracing: like [`load`], except that a raster comes back
+/// as the outlines of its layers.
 pub fn load_traceable(path: &Path, opts: &InputOptions) -> Result<Traceable> {
     let bytes = io::read_file(path)?;
     if looks_like_svg(&bytes) {
         return load_svg(path, &bytes, opts).map(Traceable::Field);
     }
-    match raster_coverage(path, &bytes, opts)? {
+    let (w, h, layers) = match raster_coverage(path, &bytes, opts)? {
         RasterCoverage::Binary { w, h, color, bits } => {
-            // The corridor is built while the loops are smoothed.
-            let (loops, corridor) = rayon::join(
-                || super::binary::bitmap_loops(&bits),
-                || super::corridor::Corridor::from_bitmap(&bits),
-            );
-            Ok(Traceable::Outline(OutlineInk {
-                width: w as f64,
-                height: h as f64,
-                color,
-                loops,
-                corridor: Some(corridor),
-            }))
+            (w, h, vec![OutlineLayer::binary(color, &bits)])
         }
-        // One anti-aliased layer: its sub-pixel outline, fitted directly.
-        RasterCoverage::Layers { w, h, layers } if layers.len() == 1 && !opts.layers => {
-            let (color, cov) = &layers[0];
-            Ok(Traceable::Outline(OutlineInk {
-                width: w as f64,
-                height: h as f64,
-                color: *color,
-                loops: super::sdf::subpixel_outline(cov)
-                    .into_par_iter()
-                    .filter(|p| p.len() >= 3)
-                    .map(super::binary::polygon_loop)
-                    .collect(),
-                corridor: None,
-            }))
-        }
-        other => Ok(Traceable::Field(other.into_ink())),
-    }
+        RasterCoverage::Layers { w, h, layers } => (
+            w,
+            h,
+            layers
+                .par_iter()
+                .map(|(color, cov)| OutlineLayer::coverage(*color, cov))
+                .collect(),
+        ),
+    };
+    Ok(Traceable::Outline(OutlineInk {
+        width: w as f64,
+        height: h as f64,
+        layers,
+    }))
 }
 
 /// Raster bytes (PNG, JPEG, …) read from `path` as ink, as [`load`] reads them.

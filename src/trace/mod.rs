@@ -253,19 +253,21 @@ fn layer_group(i: usize, paths: Vec<BezPath>, color: Color) -> Option<Group> {
 }
 
 /// Reads `path` (raster or SVG) and traces it: the library side of
-/// `flourish trace`. A binary bitmap is traced from its smooth outline
-/// ([`trace_outline`]); anything else from its SDF.
+/// `flourish trace`. A raster's layers are traced from their outlines
+/// ([`trace_outline`]); an SVG's from their SDFs.
 pub fn trace_file(path: &Path, input: &InputOptions, opts: &TraceOptions) -> Result<Document> {
     opts.validate()?;
     match input::load_traceable(path, input)? {
         Traceable::Field(ink) => trace_ink(&ink, opts),
         Traceable::Outline(o) => {
             let mut doc = Document::new(o.width, o.height, decimals_for(opts.tolerance));
-            doc.groups.extend(layer_group(
-                0,
-                trace_outline(&o.loops, o.corridor.as_ref(), opts),
-                o.color,
-            ));
+            for (i, layer) in o.layers.iter().enumerate() {
+                doc.groups.extend(layer_group(
+                    i,
+                    trace_outline(&layer.loops, layer.corridor.as_ref(), opts),
+                    layer.color,
+                ));
+            }
             Ok(doc)
         }
     }
