@@ -40,6 +40,15 @@ pub(super) fn line_cubic(a: Point, b: Point) -> CubicBez {
 /// to `share` of the span found (or half a pixel). When not even
 /// [`MIN_SPAN_PX`] fits, the polygon over that length (it lies on what is
 /// fitted).
+///
+/// On an exact outline the halving and bisection steps are taken on the
+/// cheap half of the test alone ([`probe`]: the span's samples bend
+/// gently enough, or its chord fits) and only the span they settle on is
+/// fitted and checked in full; if it fails, it becomes the failure above
+/// and the search goes on below it from the highest span that passed the
+/// cheap test. Where both halves agree (most spans) this is the same
+/// search, with one full fit per span instead of one per step that
+/// succeeds.
 pub(super) fn longest_span(
     piece: &Piece,
     start: f64,
@@ -54,37 +63,87 @@ pub(super) fn longest_span(
     }
     let total = piece.length();
     let min_span = (MIN_SPAN_PX / total).min(1.0);
-    // Halve until one cubic fits.
+    let probe = |end: f64| probe(piece, start..end, accuracy);
     let mut fail = hi;
-    let mut ok: Option<(f64, CubicBez)> = None;
-    let mut end = 0.5 * (start + fail);
-    while end - start >= min_span {
-        if let Some(c) = fit_span(piece, start..end, accuracy) {
-            ok = Some((end, c));
-            break;
-        }
-        fail = end;
-        end = 0.5 * (start + end);
-    }
-    let Some((mut good, mut cubic)) = ok else {
-        // Nothing fits even a short span: the polygon up to there.
-        let end = (start + min_span).min(1.0);
-        polygon(piece, start..end, accuracy, out);
-        return end;
-    };
-    // Bisect between the success and the failure above it.
-    while (fail - good) * total > (share * (good - start) * total).max(0.5) {
-        let mid = 0.5 * (good + fail);
-        match fit_span(piece, start..mid, accuracy) {
-            Some(c) => {
-                good = mid;
-                cubic = c;
+    // The ends found to pass so far below `fail` (ascending), with their
+    // cubic once fitted.
+    let mut goods: Vec<(f64, Option<CubicBez>)> = Vec::new();
+    loop {
+        if goods.is_empty() {
+            // Halve until one passes.
+            let mut end = 0.5 * (start + fail);
+            while end - start >= min_span {
+                match probe(end) {
+                    Probe::Fits(c) => goods.push((end, Some(c))),
+                    Probe::Likely => goods.push((end, None)),
+                    Probe::Fails => {
+                        fail = end;
+                        end = 0.5 * (start + end);
+                        continue;
+                    }
+                }
+                break;
             }
-            None => fail = mid,
+        }
+        let Some(&(mut good, mut cubic)) = goods.last() else {
+            // Nothing fits even a short span: the polygon up to there.
+            let end = (start + min_span).min(1.0);
+            polygon(piece, start..end, accuracy, out);
+            return end;
+        };
+        // Bisect between the success and the failure above it.
+        while (fail - good) * total > (share * (good - start) * total).max(0.5) {
+            let mid = 0.5 * (good + fail);
+            match probe(mid) {
+                Probe::Fits(c) => (good, cubic) = (mid, Some(c)),
+                Probe::Likely => (good, cubic) = (mid, None),
+                Probe::Fails => {
+                    fail = mid;
+                    continue;
+                }
+            }
+            goods.push((good, cubic));
+        }
+        match cubic.or_else(|| fit_span(piece, start..good, accuracy)) {
+            Some(c) => {
+                out.push(c);
+                return good;
+            }
+            None => {
+                // The cheap test passed, the fit did not.
+                goods.pop();
+                fail = good;
+            }
         }
     }
-    out.push(cubic);
-    good
+}
+
+/// What one step of [`longest_span`]'s search learns about a span.
+enum Probe {
+    /// It fits: this cubic.
+    Fits(CubicBez),
+    /// It passes the cheap test; whether it fits is found out only if the
+    /// search settles on it.
+    Likely,
+    /// It does not fit.
+    Fails,
+}
+
+/// One step of [`longest_span`]'s search over `range`: on an SDF contour
+/// the whole [`fit_span`]; on an exact outline, whether the span's samples
+/// bend gently enough for a cubic ([`is_sharp`]; the fit itself is left
+/// for later), else whether its chord fits (as [`fit_span`] does).
+fn probe(piece: &Piece, range: Range<f64>, accuracy: f64) -> Probe {
+    if let Guide::Field(_) = piece.guide {
+        return fit_span(piece, range, accuracy).map_or(Probe::Fails, Probe::Fits);
+    }
+    if piece
+        .samples_while(range.clone(), |a, b| !is_sharp(a, b))
+        .is_some()
+    {
+        return Probe::Likely;
+    }
+    chord_span(piece, range, accuracy).map_or(Probe::Fails, Probe::Fits)
 }
 
 /// One cubic for `range`: the fitted one if it passes [`fit_checked`], else
@@ -93,44 +152,47 @@ pub(super) fn longest_span(
 /// spans of a noisy outline, where the end tangents disagree with the
 /// chord and no cubic passes, are usually this).
 pub(super) fn fit_span(piece: &Piece, range: Range<f64>, accuracy: f64) -> Option<CubicBez> {
-    fit_checked(piece, range.clone(), accuracy).or_else(|| {
-        let s0 = range.start * piece.length();
-        let s1 = range.end * piece.length();
-        let a = piece.locate(s0).1;
-        let b = piece.locate(s1).1;
-        let chord = kurbo::Line::new(a, b);
-        // The vertices strictly inside (s0, s1): `cum` ascends.
-        let lo = piece.cum.partition_point(|&c| c <= s0);
-        let hi = piece.cum.partition_point(|&c| c < s1).max(lo);
-        let inner = piece.pts.get(lo..hi).unwrap_or(&[]);
-        let near_chord = |&p: &Point| {
-            crate::raster::sdf::point_segment_distance(p, chord)
-                <= piece.reach(CHORD_SHARE * accuracy)
+    fit_checked(piece, range.clone(), accuracy).or_else(|| chord_span(piece, range, accuracy))
+}
+
+/// The straight chord over `range` if the outline and the level set stay
+/// within [`CHORD_SHARE`] × `accuracy` of it (see [`fit_span`]).
+fn chord_span(piece: &Piece, range: Range<f64>, accuracy: f64) -> Option<CubicBez> {
+    let s0 = range.start * piece.length();
+    let s1 = range.end * piece.length();
+    let a = piece.locate(s0).1;
+    let b = piece.locate(s1).1;
+    let chord = kurbo::Line::new(a, b);
+    // The vertices strictly inside (s0, s1): `cum` ascends.
+    let lo = piece.cum.partition_point(|&c| c <= s0);
+    let hi = piece.cum.partition_point(|&c| c < s1).max(lo);
+    let inner = piece.pts.get(lo..hi).unwrap_or(&[]);
+    let near_chord = |&p: &Point| {
+        crate::raster::sdf::point_segment_distance(p, chord) <= piece.reach(CHORD_SHARE * accuracy)
+    };
+    // Every eighth vertex first: a curved span strays from its chord
+    // mid-way, and most spans reaching here are curved.
+    let stride = (inner.len() / 8).max(1);
+    let within = inner
+        .iter()
+        .skip(stride / 2)
+        .step_by(stride)
+        .all(near_chord)
+        && inner.iter().all(near_chord);
+    let on_level_set = || {
+        // On an outline, as a cubic's (see `super::direct`).
+        let m = match piece.guide {
+            Guide::Outline(_) => super::direct::check_chords((b - a).hypot()),
+            Guide::Field(_) => 64,
         };
-        // Every eighth vertex first: a curved span strays from its chord
-        // mid-way, and most spans reaching here are curved.
-        let stride = (inner.len() / 8).max(1);
-        let within = inner
-            .iter()
-            .skip(stride / 2)
-            .step_by(stride)
-            .all(near_chord)
-            && inner.iter().all(near_chord);
-        let on_level_set = || {
-            // On an outline, as a cubic's (see `super::direct`).
-            let m = match piece.guide {
-                Guide::Outline(_) => super::direct::check_chords((b - a).hypot()),
-                Guide::Field(_) => 64,
-            };
-            piece.holds(
-                (1..m).map(|k| a.lerp(b, k as f64 / m as f64)),
-                s0,
-                s1,
-                CHORD_SHARE * accuracy,
-            )
-        };
-        (a != b && within && on_level_set()).then(|| line_cubic(a, b))
-    })
+        piece.holds(
+            (1..m).map(|k| a.lerp(b, k as f64 / m as f64)),
+            s0,
+            s1,
+            CHORD_SHARE * accuracy,
+        )
+    };
+    (a != b && within && on_level_set()).then(|| line_cubic(a, b))
 }
 
 /// The share of the accuracy a straight chord may use (see [`fit_span`]).
