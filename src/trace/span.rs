@@ -67,15 +67,15 @@ pub(super) fn longest_span(
     let mut fail = hi;
     // The ends found to pass so far below `fail` (ascending), with their
     // cubic once fitted.
-    let mut goods: Vec<(f64, Option<CubicBez>)> = Vec::new();
+    let mut goods: Vec<(f64, Known)> = Vec::new();
     loop {
         if goods.is_empty() {
             // Halve until one passes.
             let mut end = 0.5 * (start + fail);
             while end - start >= min_span {
                 match probe(end) {
-                    Probe::Fits(c) => goods.push((end, Some(c))),
-                    Probe::Likely => goods.push((end, None)),
+                    Probe::Fits(c) => goods.push((end, Known::Fits(c))),
+                    Probe::Likely(samples) => goods.push((end, Known::Likely(samples))),
                     Probe::Fails => {
                         fail = end;
                         end = 0.5 * (start + end);
@@ -85,7 +85,7 @@ pub(super) fn longest_span(
                 break;
             }
         }
-        let Some(&(mut good, mut cubic)) = goods.last() else {
+        let Some((mut good, mut cubic)) = goods.last().cloned() else {
             // Nothing fits even a short span: the polygon up to there.
             let end = (start + min_span).min(1.0);
             polygon(piece, start..end, accuracy, out);
@@ -95,16 +95,24 @@ pub(super) fn longest_span(
         while (fail - good) * total > (share * (good - start) * total).max(0.5) {
             let mid = 0.5 * (good + fail);
             match probe(mid) {
-                Probe::Fits(c) => (good, cubic) = (mid, Some(c)),
-                Probe::Likely => (good, cubic) = (mid, None),
+                Probe::Fits(c) => (good, cubic) = (mid, Known::Fits(c)),
+                Probe::Likely(samples) => (good, cubic) = (mid, Known::Likely(samples)),
                 Probe::Fails => {
                     fail = mid;
                     continue;
                 }
             }
-            goods.push((good, cubic));
+            goods.push((good, cubic.clone()));
         }
-        match cubic.or_else(|| fit_span(piece, start..good, accuracy)) {
+        let fitted = match cubic {
+            Known::Fits(c) => Some(c),
+            Known::Likely(samples) => {
+                // The samples the probe took: the same range.
+                super::direct::fit_span_direct(piece, start..good, &samples, accuracy)
+                    .or_else(|| chord_span(piece, start..good, accuracy))
+            }
+        };
+        match fitted {
             Some(c) => {
                 out.push(c);
                 return good;
@@ -118,13 +126,25 @@ pub(super) fn longest_span(
     }
 }
 
+/// A span's [`FIT_SAMPLES`] samples (position, px, and unit tangent).
+type Samples = [(Point, Vec2); FIT_SAMPLES];
+
+/// What [`longest_span`] knows of a span that passed a probe.
+#[derive(Clone)]
+enum Known {
+    /// It fits: this cubic.
+    Fits(CubicBez),
+    /// It passed the cheap test with these samples.
+    Likely(Box<Samples>),
+}
+
 /// What one step of [`longest_span`]'s search learns about a span.
 enum Probe {
     /// It fits: this cubic.
     Fits(CubicBez),
-    /// It passes the cheap test; whether it fits is found out only if the
-    /// search settles on it.
-    Likely,
+    /// It passes the cheap test (these are the span's samples); whether it
+    /// fits is found out only if the search settles on it.
+    Likely(Box<Samples>),
     /// It does not fit.
     Fails,
 }
@@ -137,11 +157,8 @@ fn probe(piece: &Piece, range: Range<f64>, accuracy: f64) -> Probe {
     if let Guide::Field(_) = piece.guide {
         return fit_span(piece, range, accuracy).map_or(Probe::Fails, Probe::Fits);
     }
-    if piece
-        .samples_while(range.clone(), |a, b| !is_sharp(a, b))
-        .is_some()
-    {
-        return Probe::Likely;
+    if let Some(samples) = piece.samples_while(range.clone(), |a, b| !is_sharp(a, b)) {
+        return Probe::Likely(Box::new(samples));
     }
     chord_span(piece, range, accuracy).map_or(Probe::Fails, Probe::Fits)
 }
