@@ -320,6 +320,83 @@ mod tests {
     use super::*;
     use kurbo::ParamCurveNearest;
 
+    /// The search on an exact outline (cheap probes, one full fit where it
+    /// settles) covers a spiral contiguously with cubics that each stay
+    /// within the accuracy of the outline (measured by brute force at 64
+    /// points against every segment), and with no more spans than a brute
+    /// force greedy cover (the longest end on a grid of 1/256 of the
+    /// length that `fit_span` accepts, tried from the top) needs, give or
+    /// take one.
+    #[test]
+    fn probe_search_covers_a_spiral_like_brute_force() {
+        use crate::raster::sdf::point_segment_distance;
+        // r = 20 + 6θ over a turn and a half, at 0.5-px steps or so.
+        let f = |t: f64| {
+            let a = 3.0 * std::f64::consts::PI * t;
+            let r = 20.0 + 6.0 * a;
+            Point::new(60.0 + r * a.cos(), 60.0 + r * a.sin())
+        };
+        let df = |t: f64| {
+            let a = 3.0 * std::f64::consts::PI * t;
+            let r = 20.0 + 6.0 * a;
+            Vec2::new(6.0 * a.cos() - r * a.sin(), 6.0 * a.sin() + r * a.cos()).normalize()
+        };
+        let n = 500;
+        let ts: Vec<f64> = (0..=n).map(|i| i as f64 / n as f64).collect();
+        let pts: Vec<Point> = ts.iter().map(|&t| f(t)).collect();
+        let piece = Piece::new(
+            pts.clone(),
+            ts.iter().map(|&t| df(t)).collect(),
+            Guide::Outline(None),
+            false,
+            false,
+        );
+        let accuracy = 0.25;
+        let mut cubics = Vec::new();
+        let mut start = 0.0;
+        let mut spans = 0;
+        while start < 1.0 {
+            let before = cubics.len();
+            let end = longest_span(&piece, start, 1.0, 0.125, accuracy, &mut cubics);
+            assert!(end > start && cubics.len() > before);
+            start = end;
+            spans += 1;
+        }
+        for w in cubics.windows(2) {
+            assert_eq!(w[0].p3, w[1].p0);
+        }
+        assert_eq!(cubics[0].p0, pts[0]);
+        assert_eq!(cubics[cubics.len() - 1].p3, pts[n]);
+        for c in &cubics {
+            for k in 0..=64 {
+                let q = c.eval(k as f64 / 64.0);
+                let d = pts
+                    .windows(2)
+                    .map(|w| point_segment_distance(q, kurbo::Line::new(w[0], w[1])))
+                    .fold(f64::INFINITY, f64::min);
+                assert!(d <= accuracy + 0.05, "{q:?} is {d} px off");
+            }
+        }
+        let grid = 256;
+        let (mut at, mut greedy) = (0usize, 0usize);
+        while at < grid {
+            let end = (at + 1..=grid)
+                .rev()
+                .find(|&e| {
+                    fit_span(
+                        &piece,
+                        at as f64 / grid as f64..e as f64 / grid as f64,
+                        accuracy,
+                    )
+                    .is_some()
+                })
+                .unwrap_or(at + 1);
+            at = end;
+            greedy += 1;
+        }
+        assert!(spans <= greedy + 1, "{spans} spans, brute force {greedy}");
+    }
+
     /// The fallback polygon over a tight turn (a flattened half circle of
     /// radius 0.4 px, 24 points) is a handful of lines, every vertex of the
     /// outline within the accuracy of them.
