@@ -7,8 +7,8 @@
 //! longest span that one cubic fits is searched for (the direct fitter of
 //! `super::direct`, which matches area and first moment under the end
 //! tangents and judges each candidate by the outline itself both ways; see
-//! `super::span::fit_span`), halving and then bisecting down to an
-//! eighth of the span; the span is only capped by how much the outline turns
+//! `super::span::fit_span`), halving and then bisecting down to
+//! `SEARCH_SHARE` of the span; the span is only capped by how much the outline turns
 //! within it ([`MAX_SPAN_TURN`]), not cut into fixed pieces beforehand, so
 //! a run costs no more cubics than its shape needs. When fitting is
 //! monotone in the span (a sub-span of a span that fits, fits), extending
@@ -36,8 +36,12 @@ const TURN_STEP: f64 = 3.0;
 
 /// The search for the end of a span stops when the bracket between the
 /// longest span that fits and the shortest that does not is below this
-/// share of the span (or half a pixel).
-const SEARCH_SHARE: f64 = 0.125;
+/// share of the span (or half a pixel): 3/16, one bisection step fewer
+/// than an eighth on most spans (fit work −7 % on the 2 Mpx ornament) for
+/// about the same number of cubics (3082 → 3148 there; all samples 5198 →
+/// 5319, 0.79× potrace's, as before the cheap-probe search); a quarter
+/// cost another 5 % of the work and added 2 % more cubics.
+const SEARCH_SHARE: f64 = 0.1875;
 
 /// Fits a closed outline (pixel coordinates) with cubic Béziers within
 /// `accuracy` px of it, appending a closed subpath to `out`: `tangents` are

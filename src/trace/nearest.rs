@@ -33,6 +33,20 @@ pub(super) fn nearest_segment(
     // Once a segment within `far` is known only `near` matters.
     let mut bound = far;
     let mut j = from;
+    // The first segment is measured outright: the search mostly starts
+    // where the point lies (`nearest_from`'s cursor), and there the bound
+    // below only costs a root and a galloping search.
+    if j <= to && j + 1 < pts.len() {
+        let d = crate::raster::sdf::point_segment_distance(p, kurbo::Line::new(pts[j], pts[j + 1]));
+        if d <= near {
+            return (Some(j), d);
+        }
+        if d <= far {
+            best = d;
+            bound = near;
+        }
+        j += 1;
+    }
     while j <= to && j < pts.len().saturating_sub(1) {
         // Squared first: most points are within the bound of the vertex.
         let v2 = (p - pts[j]).hypot2();

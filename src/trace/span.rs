@@ -40,6 +40,15 @@ pub(super) fn line_cubic(a: Point, b: Point) -> CubicBez {
 /// to `share` of the span found (or half a pixel). When not even
 /// [`MIN_SPAN_PX`] fits, the polygon over that length (it lies on what is
 /// fitted).
+///
+/// On an exact outline the halving and bisection steps are taken on the
+/// cheap half of the test alone ([`probe`]: the span's samples bend
+/// gently enough, or its chord fits) and only the span they settle on is
+/// fitted and checked in full; if it fails, it becomes the failure above
+/// and the search goes on below it from the highest span that passed the
+/// cheap test. Where both halves agree (most spans) this is the same
+/// search, with one full fit per span instead of one per step that
+/// succeeds.
 pub(super) fn longest_span(
     piece: &Piece,
     start: f64,
@@ -54,37 +63,104 @@ pub(super) fn longest_span(
     }
     let total = piece.length();
     let min_span = (MIN_SPAN_PX / total).min(1.0);
-    // Halve until one cubic fits.
+    let probe = |end: f64| probe(piece, start..end, accuracy);
     let mut fail = hi;
-    let mut ok: Option<(f64, CubicBez)> = None;
-    let mut end = 0.5 * (start + fail);
-    while end - start >= min_span {
-        if let Some(c) = fit_span(piece, start..end, accuracy) {
-            ok = Some((end, c));
-            break;
-        }
-        fail = end;
-        end = 0.5 * (start + end);
-    }
-    let Some((mut good, mut cubic)) = ok else {
-        // Nothing fits even a short span: the polygon up to there.
-        let end = (start + min_span).min(1.0);
-        polygon(piece, start..end, accuracy, out);
-        return end;
-    };
-    // Bisect between the success and the failure above it.
-    while (fail - good) * total > (share * (good - start) * total).max(0.5) {
-        let mid = 0.5 * (good + fail);
-        match fit_span(piece, start..mid, accuracy) {
-            Some(c) => {
-                good = mid;
-                cubic = c;
+    // The ends found to pass so far below `fail` (ascending), with their
+    // cubic once fitted.
+    let mut goods: Vec<(f64, Known)> = Vec::new();
+    loop {
+        if goods.is_empty() {
+            // Halve until one passes.
+            let mut end = 0.5 * (start + fail);
+            while end - start >= min_span {
+                match probe(end) {
+                    Probe::Fits(c) => goods.push((end, Known::Fits(c))),
+                    Probe::Likely(samples) => goods.push((end, Known::Likely(samples))),
+                    Probe::Fails => {
+                        fail = end;
+                        end = 0.5 * (start + end);
+                        continue;
+                    }
+                }
+                break;
             }
-            None => fail = mid,
+        }
+        let Some((mut good, mut cubic)) = goods.last().cloned() else {
+            // Nothing fits even a short span: the polygon up to there.
+            let end = (start + min_span).min(1.0);
+            polygon(piece, start..end, accuracy, out);
+            return end;
+        };
+        // Bisect between the success and the failure above it.
+        while (fail - good) * total > (share * (good - start) * total).max(0.5) {
+            let mid = 0.5 * (good + fail);
+            match probe(mid) {
+                Probe::Fits(c) => (good, cubic) = (mid, Known::Fits(c)),
+                Probe::Likely(samples) => (good, cubic) = (mid, Known::Likely(samples)),
+                Probe::Fails => {
+                    fail = mid;
+                    continue;
+                }
+            }
+            goods.push((good, cubic.clone()));
+        }
+        let fitted = match cubic {
+            Known::Fits(c) => Some(c),
+            Known::Likely(samples) => {
+                // The samples the probe took: the same range.
+                super::direct::fit_span_direct(piece, start..good, &samples, accuracy)
+                    .or_else(|| chord_span(piece, start..good, accuracy))
+            }
+        };
+        match fitted {
+            Some(c) => {
+                out.push(c);
+                return good;
+            }
+            None => {
+                // The cheap test passed, the fit did not.
+                goods.pop();
+                fail = good;
+            }
         }
     }
-    out.push(cubic);
-    good
+}
+
+/// A span's [`FIT_SAMPLES`] samples (position, px, and unit tangent).
+type Samples = [(Point, Vec2); FIT_SAMPLES];
+
+/// What [`longest_span`] knows of a span that passed a probe.
+#[derive(Clone)]
+enum Known {
+    /// It fits: this cubic.
+    Fits(CubicBez),
+    /// It passed the cheap test with these samples.
+    Likely(Box<Samples>),
+}
+
+/// What one step of [`longest_span`]'s search learns about a span.
+enum Probe {
+    /// It fits: this cubic.
+    Fits(CubicBez),
+    /// It passes the cheap test (these are the span's samples); whether it
+    /// fits is found out only if the search settles on it.
+    Likely(Box<Samples>),
+    /// It does not fit.
+    Fails,
+}
+
+/// One step of [`longest_span`]'s search over `range`: on an SDF contour
+/// the whole [`fit_span`]; on an exact outline, whether the span's samples
+/// bend gently enough for a cubic ([`is_sharp`]; the fit itself is left
+/// for later), else whether its chord fits (as [`fit_span`] does).
+fn probe(piece: &Piece, range: Range<f64>, accuracy: f64) -> Probe {
+    if let Guide::Field(_) = piece.guide {
+        return fit_span(piece, range, accuracy).map_or(Probe::Fails, Probe::Fits);
+    }
+    if let Some(samples) = piece.samples_while(range.clone(), |a, b| !is_sharp(a, b)) {
+        return Probe::Likely(Box::new(samples));
+    }
+    chord_span(piece, range, accuracy).map_or(Probe::Fails, Probe::Fits)
 }
 
 /// One cubic for `range`: the fitted one if it passes [`fit_checked`], else
@@ -93,44 +169,47 @@ pub(super) fn longest_span(
 /// spans of a noisy outline, where the end tangents disagree with the
 /// chord and no cubic passes, are usually this).
 pub(super) fn fit_span(piece: &Piece, range: Range<f64>, accuracy: f64) -> Option<CubicBez> {
-    fit_checked(piece, range.clone(), accuracy).or_else(|| {
-        let s0 = range.start * piece.length();
-        let s1 = range.end * piece.length();
-        let a = piece.locate(s0).1;
-        let b = piece.locate(s1).1;
-        let chord = kurbo::Line::new(a, b);
-        // The vertices strictly inside (s0, s1): `cum` ascends.
-        let lo = piece.cum.partition_point(|&c| c <= s0);
-        let hi = piece.cum.partition_point(|&c| c < s1).max(lo);
-        let inner = piece.pts.get(lo..hi).unwrap_or(&[]);
-        let near_chord = |&p: &Point| {
-            crate::raster::sdf::point_segment_distance(p, chord)
-                <= piece.reach(CHORD_SHARE * accuracy)
+    fit_checked(piece, range.clone(), accuracy).or_else(|| chord_span(piece, range, accuracy))
+}
+
+/// The straight chord over `range` if the outline and the level set stay
+/// within [`CHORD_SHARE`] × `accuracy` of it (see [`fit_span`]).
+fn chord_span(piece: &Piece, range: Range<f64>, accuracy: f64) -> Option<CubicBez> {
+    let s0 = range.start * piece.length();
+    let s1 = range.end * piece.length();
+    let a = piece.locate(s0).1;
+    let b = piece.locate(s1).1;
+    let chord = kurbo::Line::new(a, b);
+    // The vertices strictly inside (s0, s1): `cum` ascends.
+    let lo = piece.cum.partition_point(|&c| c <= s0);
+    let hi = piece.cum.partition_point(|&c| c < s1).max(lo);
+    let inner = piece.pts.get(lo..hi).unwrap_or(&[]);
+    let near_chord = |&p: &Point| {
+        crate::raster::sdf::point_segment_distance(p, chord) <= piece.reach(CHORD_SHARE * accuracy)
+    };
+    // Every eighth vertex first: a curved span strays from its chord
+    // mid-way, and most spans reaching here are curved.
+    let stride = (inner.len() / 8).max(1);
+    let within = inner
+        .iter()
+        .skip(stride / 2)
+        .step_by(stride)
+        .all(near_chord)
+        && inner.iter().all(near_chord);
+    let on_level_set = || {
+        // On an outline, as a cubic's (see `super::direct`).
+        let m = match piece.guide {
+            Guide::Outline(_) => super::direct::check_chords((b - a).hypot()),
+            Guide::Field(_) => 64,
         };
-        // Every eighth vertex first: a curved span strays from its chord
-        // mid-way, and most spans reaching here are curved.
-        let stride = (inner.len() / 8).max(1);
-        let within = inner
-            .iter()
-            .skip(stride / 2)
-            .step_by(stride)
-            .all(near_chord)
-            && inner.iter().all(near_chord);
-        let on_level_set = || {
-            // On an outline, as a cubic's (see `super::direct`).
-            let m = match piece.guide {
-                Guide::Outline(_) => super::direct::check_chords((b - a).hypot()),
-                Guide::Field(_) => 64,
-            };
-            piece.holds(
-                (1..m).map(|k| a.lerp(b, k as f64 / m as f64)),
-                s0,
-                s1,
-                CHORD_SHARE * accuracy,
-            )
-        };
-        (a != b && within && on_level_set()).then(|| line_cubic(a, b))
-    })
+        piece.holds(
+            (1..m).map(|k| a.lerp(b, k as f64 / m as f64)),
+            s0,
+            s1,
+            CHORD_SHARE * accuracy,
+        )
+    };
+    (a != b && within && on_level_set()).then(|| line_cubic(a, b))
 }
 
 /// The share of the accuracy a straight chord may use (see [`fit_span`]).
@@ -240,6 +319,83 @@ fn is_sharp(a: Vec2, b: Vec2) -> bool {
 mod tests {
     use super::*;
     use kurbo::ParamCurveNearest;
+
+    /// The search on an exact outline (cheap probes, one full fit where it
+    /// settles) covers a spiral contiguously with cubics that each stay
+    /// within the accuracy of the outline (measured by brute force at 64
+    /// points against every segment), and with no more spans than a brute
+    /// force greedy cover (the longest end on a grid of 1/256 of the
+    /// length that `fit_span` accepts, tried from the top) needs, give or
+    /// take one.
+    #[test]
+    fn probe_search_covers_a_spiral_like_brute_force() {
+        use crate::raster::sdf::point_segment_distance;
+        // r = 20 + 6θ over a turn and a half, at 0.5-px steps or so.
+        let f = |t: f64| {
+            let a = 3.0 * std::f64::consts::PI * t;
+            let r = 20.0 + 6.0 * a;
+            Point::new(60.0 + r * a.cos(), 60.0 + r * a.sin())
+        };
+        let df = |t: f64| {
+            let a = 3.0 * std::f64::consts::PI * t;
+            let r = 20.0 + 6.0 * a;
+            Vec2::new(6.0 * a.cos() - r * a.sin(), 6.0 * a.sin() + r * a.cos()).normalize()
+        };
+        let n = 500;
+        let ts: Vec<f64> = (0..=n).map(|i| i as f64 / n as f64).collect();
+        let pts: Vec<Point> = ts.iter().map(|&t| f(t)).collect();
+        let piece = Piece::new(
+            pts.clone(),
+            ts.iter().map(|&t| df(t)).collect(),
+            Guide::Outline(None),
+            false,
+            false,
+        );
+        let accuracy = 0.25;
+        let mut cubics = Vec::new();
+        let mut start = 0.0;
+        let mut spans = 0;
+        while start < 1.0 {
+            let before = cubics.len();
+            let end = longest_span(&piece, start, 1.0, 0.125, accuracy, &mut cubics);
+            assert!(end > start && cubics.len() > before);
+            start = end;
+            spans += 1;
+        }
+        for w in cubics.windows(2) {
+            assert_eq!(w[0].p3, w[1].p0);
+        }
+        assert_eq!(cubics[0].p0, pts[0]);
+        assert_eq!(cubics[cubics.len() - 1].p3, pts[n]);
+        for c in &cubics {
+            for k in 0..=64 {
+                let q = c.eval(k as f64 / 64.0);
+                let d = pts
+                    .windows(2)
+                    .map(|w| point_segment_distance(q, kurbo::Line::new(w[0], w[1])))
+                    .fold(f64::INFINITY, f64::min);
+                assert!(d <= accuracy + 0.05, "{q:?} is {d} px off");
+            }
+        }
+        let grid = 256;
+        let (mut at, mut greedy) = (0usize, 0usize);
+        while at < grid {
+            let end = (at + 1..=grid)
+                .rev()
+                .find(|&e| {
+                    fit_span(
+                        &piece,
+                        at as f64 / grid as f64..e as f64 / grid as f64,
+                        accuracy,
+                    )
+                    .is_some()
+                })
+                .unwrap_or(at + 1);
+            at = end;
+            greedy += 1;
+        }
+        assert!(spans <= greedy + 1, "{spans} spans, brute force {greedy}");
+    }
 
     /// The fallback polygon over a tight turn (a flattened half circle of
     /// radius 0.4 px, 24 points) is a handful of lines, every vertex of the
