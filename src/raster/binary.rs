@@ -50,7 +50,7 @@
 //! the sign and the distance agree.
 
 use crate::raster::paths::{self, Bitmap};
-use crate::raster::polygon::{optimal_polygon, Runs};
+use crate::raster::polygon::{optimal_polygon, possible_segments, straight_runs};
 use crate::raster::{line_ends, Coverage, Grid, Sdf};
 use crate::trace::contour;
 use kurbo::{CubicBez, ParamCurve, ParamCurveDeriv, Point, Vec2};
@@ -116,19 +116,8 @@ fn smooth_loop(path: &[Point]) -> SmoothLoop {
     if n < 4 {
         return polyline_loop(path);
     }
-    // Runs are computed only where the polygon search lands (memoized): a
-    // greedy cover visits a few vertices per run length, not all of them.
-    let runs = Runs::new(path);
-    let mut memo = vec![0usize; n];
-    let poly = optimal_polygon(
-        |i| {
-            if memo[i] == 0 {
-                memo[i] = runs.from(i);
-            }
-            memo[i]
-        },
-        n,
-    );
+    let ahead = possible_segments(&straight_runs(path));
+    let poly = optimal_polygon(path, &ahead);
     if poly.len() < 3 {
         return polyline_loop(path);
     }
