@@ -51,6 +51,7 @@
 
 use crate::raster::paths::{self, Bitmap};
 use crate::raster::polygon::{optimal_polygon, possible_segments, straight_runs};
+use crate::raster::vertices::{adjust_vertices, edge_lines};
 use crate::raster::{line_ends, Coverage, Grid, Sdf};
 use crate::trace::contour;
 use kurbo::{CubicBez, ParamCurve, ParamCurveDeriv, Point, Vec2};
@@ -146,90 +147,6 @@ fn unit(v: Vec2) -> Vec2 {
     } else {
         Vec2::new(1.0, 0.0)
     }
-}
-
-/// The least-squares line (centroid, unit direction from the edge's start
-/// to its end) of each polygon edge's path vertices, the chamfered ends
-/// left out: edge `e` runs from `poly[e]` to `poly[e + 1]`.
-pub(super) fn edge_lines(path: &[Point], poly: &[usize]) -> Vec<(Point, Vec2)> {
-    let n = path.len();
-    let k = poly.len();
-    (0..k)
-        .map(|e| {
-            let a = poly[e];
-            let b = poly[(e + 1) % k];
-            let count = (b + n - a) % n + 1;
-            // The end vertices are where the path rounds the polygon's
-            // corners (midpoints of pixel edges chamfer every pixel corner
-            // by half a pixel): they belong to neither edge's line.
-            let at = |s: usize| path[(a + s) % n];
-            let chamfer = |end: usize, inner: usize, next: usize| {
-                let d0 = at(inner) - at(end);
-                let d1 = at(next) - at(inner);
-                let diagonal = (d0.x.abs() - 0.5).abs() < 1e-9 && (d0.y.abs() - 0.5).abs() < 1e-9;
-                let axis = (d1.x.abs() - 1.0).abs() < 1e-9 || (d1.y.abs() - 1.0).abs() < 1e-9;
-                count >= 4 && diagonal && axis
-            };
-            let first = usize::from(count >= 4 && chamfer(0, 1, 2));
-            let last = usize::from(count >= 4 && chamfer(count - 1, count - 2, count - 3));
-            let pts = (first..count - last).map(at);
-            fit_line(pts, path[a], path[b])
-        })
-        .collect()
-}
-
-/// Step 4: polygon vertices moved to where the least-squares lines of their
-/// two edges ([`edge_lines`]) meet, within half a pixel of the path vertex.
-fn adjust_vertices(path: &[Point], poly: &[usize], lines: &[(Point, Vec2)]) -> Vec<Point> {
-    let k = poly.len();
-    (0..k)
-        .map(|e| {
-            let v = path[poly[e]];
-            let (c0, d0) = lines[(e + k - 1) % k];
-            let (c1, d1) = lines[e];
-            let det = d0.cross(d1);
-            let p = if det.abs() < 1e-9 {
-                v
-            } else {
-                let t = (c1 - c0).cross(d1) / det;
-                c0 + d0 * t
-            };
-            Point::new(
-                p.x.clamp(v.x - 0.5, v.x + 0.5),
-                p.y.clamp(v.y - 0.5, v.y + 0.5),
-            )
-        })
-        .collect()
-}
-
-/// Total least squares line through `pts`: centroid and principal direction
-/// (oriented from `a` to `b`).
-fn fit_line(pts: impl Iterator<Item = Point>, a: Point, b: Point) -> (Point, Vec2) {
-    let pts: Vec<Point> = pts.collect();
-    let m = pts.len().max(1) as f64;
-    let c = pts.iter().fold(Vec2::ZERO, |s, p| s + p.to_vec2()) / m;
-    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
-    for p in &pts {
-        let d = p.to_vec2() - c;
-        sxx += d.x * d.x;
-        sxy += d.x * d.y;
-        syy += d.y * d.y;
-    }
-    let angle = 0.5 * (2.0 * sxy).atan2(sxx - syy);
-    let mut d = Vec2::new(angle.cos(), angle.sin());
-    let chord = b - a;
-    if chord.hypot() > 1e-9 && d.dot(chord) < 0.0 {
-        d = -d;
-    }
-    if pts.len() < 2 || !d.x.is_finite() {
-        let l = chord.hypot();
-        d = if l > 1e-9 {
-            chord / l
-        } else {
-            Vec2::new(1.0, 0.0)
-        };
-    }
-    (c.to_point(), d)
 }
 
 /// Step 5: corners and cubics through the edge midpoints, flattened, with
