@@ -125,6 +125,7 @@ fn smooth_loop(path: &[Point]) -> SmoothLoop {
     let lines = edge_lines(path, &poly);
     let vertices = adjust_vertices(path, &poly, &lines);
     let (vertices, caps) = line_ends::square_line_ends(path, &poly, &lines, vertices);
+    let (vertices, caps) = line_ends::mitre_short_edges(vertices, caps);
     smooth_polygon(&vertices, &caps)
 }
 
