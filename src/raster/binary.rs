@@ -12,23 +12,28 @@
 //!    ±½ field, ties joining the ink as everywhere in flourish), walked on
 //!    the bits ([`paths`]).
 //! 2. **Straight runs.** For every vertex `i`, the furthest vertex `j` such
-//!    that the segment `i → j` passes within [`STRAIGHT_TOLERANCE`] of every
-//!    vertex between them and every step advances along it (a cone of
-//!    admissible directions is narrowed vertex by vertex, so this is linear
-//!    in the run length). Runs are anchored at path vertices, which are
-//!    themselves up to half a pixel off the drawn edge, so on shallow
-//!    staircases they are shorter than potrace's unanchored test allows;
-//!    steps 4–5 and the curve fitter downstream make up most of that.
-//! 3. **Optimal polygon.** The fewest such segments around the loop: a
-//!    greedy jump to the furthest straight vertex is optimal from a given
-//!    start, and several starts are tried. (Steps 2–3 live in the private
-//!    module `raster::polygon`.)
-//! 4. **Vertex adjustment.** Each polygon vertex moves to the intersection
-//!    of the least-squares lines of its two edges' path vertices (their
-//!    interior ones: the ends chamfer the corner), kept within half a pixel
-//!    of where it was. Where the outline makes a U-turn over a vertex or a
-//!    short edge (the end of a line up to 3½ px wide), the turn becomes a
-//!    square cap at the farthest pixel edge (`super::line_ends`).
+//!    that a line from `i` passes through the L∞ box of half-side
+//!    [`STRAIGHT_TOLERANCE`] round every vertex between them, every step
+//!    advances along it, and the steps keep to two neighbouring directions
+//!    of the eight (potrace's straight paths, Selinger 2003, §2.2.1, as its
+//!    implementation anchors them; the direction rule keeps a run from
+//!    turning round a line's end). A cone of admissible directions is
+//!    narrowed vertex by vertex, jumping along repeated steps.
+//! 3. **Optimal polygon** (§2.2.2). Reaches made monotone (every
+//!    sub-segment of a possible segment is possible), then the fewest
+//!    segments round the loop and, of those, the least sum of potrace's
+//!    penalties (chord length × r.m.s. distance of the path from the
+//!    chord), by potrace's dynamic programme from the start whose greedy
+//!    cover is shortest. (Steps 2–3: the private module `raster::polygon`.)
+//! 4. **Vertex adjustment** (§2.3.1). Each edge gets the least-squares line
+//!    of its path vertices (the interior ones: the ends chamfer the
+//!    corner); each vertex moves to the point of the box of half-side ½
+//!    round its path vertex nearest to its two edges' lines (the private
+//!    module `raster::vertices`). Where the outline makes a U-turn over a
+//!    vertex or a short edge (the end of a line up to 3½ px wide), the turn
+//!    becomes a square cap at the farthest pixel edge; a short edge at a
+//!    sharp turn (a thin zigzag's apex) becomes a mitre, cut 1.5 px out
+//!    (`super::line_ends`).
 //! 5. **Smoothing.** Each vertex becomes either a corner or a cubic from
 //!    the midpoint of its incoming edge to the midpoint of its outgoing
 //!    edge, with control points a fraction `α` of the way to the vertex; `α`

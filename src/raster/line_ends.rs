@@ -19,6 +19,12 @@
 //! (the tip lies on the pixel edge that ends the line). The cap's vertices
 //! stay corners in smoothing: the bitmap keeps a thin line's width to its
 //! last pixel, where potrace's corner measure would round the end off.
+//!
+//! And where a thin line turns sharply (a zigzag's apex), the polygon has
+//! a short edge between two half-turns that the corner measure reads as
+//! smooth: [`mitre_short_edges`] replaces it by the mitre of its long
+//! neighbours, cut square to the bisector where it would overshoot the
+//! pixels by more than [`MITRE_OUT`] (convex) or [`MITRE_IN`] (concave).
 
 use kurbo::{Point, Vec2};
 
