@@ -32,6 +32,7 @@
 
 use super::binary::STRAIGHT_TOLERANCE;
 use kurbo::{Point, Vec2};
+use rayon::prelude::*;
 
 /// Longest straight run considered, in path vertices.
 const MAX_RUN: usize = 400;
@@ -45,17 +46,30 @@ pub(super) const START_TRIES: usize = 32;
 ///
 /// The path's steps come in few directions, and long stretches repeat one
 /// (a pixel edge, a 45° staircase of edge midpoints). Along such a stretch
-/// every test below is settled by its two ends: a box corner's offset from
-/// the anchor is affine along a straight stretch, the cone of admissible
-/// directions is an angular interval, a stretch that advances keeps
-/// advancing and steps in one direction. So the walk jumps from stretch
+/// every test below is settled by its two ends: a vertex's L∞ distance
+/// from a line through the anchor is affine along a straight stretch, the
+/// cone of admissible directions is an angular interval, and a stretch
+/// steps in one direction. So the walk jumps from stretch
 /// end to stretch end and only steps vertex by vertex through the stretch
 /// where the run ends. The result is the same as [`run_from`] applied at
 /// every vertex (tested).
 pub(super) fn straight_runs(path: &[Point]) -> Vec<usize> {
     let runs = Runs::new(path);
-    (0..path.len()).map(|i| runs.from(i)).collect()
+    if path.len() >= PARALLEL_RUNS {
+        // A long loop (an ornament's outline holds most of its vertices)
+        // is split across threads; the runs are collected in order.
+        (0..path.len())
+            .into_par_iter()
+            .with_min_len(PARALLEL_RUNS / 2)
+            .map(|i| runs.from(i))
+            .collect()
+    } else {
+        (0..path.len()).map(|i| runs.from(i)).collect()
+    }
 }
+
+/// Loops with at least this many vertices compute their runs in parallel.
+const PARALLEL_RUNS: usize = 4096;
 
 /// What the straight-run walk needs of a path, computed once: its steps and
 /// how far each step repeats. [`Runs::from`] is then one vertex's run, so
@@ -118,7 +132,7 @@ impl<'a> Runs<'a> {
                 // The stretch's first step must advance, and its end must
                 // pass; then every vertex between passes too.
                 let first = (j + 1) % n;
-                if !run.advances(path[first], steps[first]) {
+                if !run.advances(steps[first].0) {
                     break;
                 }
                 if run.admits(path[e]) {
@@ -138,7 +152,7 @@ impl<'a> Runs<'a> {
                     break;
                 }
                 let k = (j + 1) % n;
-                if !(run.advances(path[k], steps[k]) && run.admits(path[k])) {
+                if !(run.advances(steps[k].0) && run.admits(path[k])) {
                     ended = true;
                     break;
                 }
@@ -193,8 +207,6 @@ struct Run {
     /// The cone of admissible directions, as its right and left edge
     /// vectors (counter-clockwise from right to left); None = any.
     cone: Option<(Vec2, Vec2)>,
-    /// The farthest distance from the anchor of a vertex taken so far.
-    farthest: f64,
     /// The directions (of eight) of the steps taken so far, as bits.
     dirs: u8,
 }
@@ -204,7 +216,6 @@ impl Run {
         Run {
             anchor,
             cone: None,
-            farthest: 0.0,
             dirs: 0,
         }
     }
@@ -215,9 +226,11 @@ impl Run {
     /// (potrace's rule that a straight path never steps in all four
     /// directions, for paths that also step diagonally): a run does not
     /// turn round the end of a line, whose two sides would otherwise be
-    /// one run within the tolerance of a 1-px line's vertices. And every
-    /// step must advance along the run, so a notch's back step ends it.
-    fn advances(&mut self, q: Point, (step, step_len): (Vec2, f64)) -> bool {
+    /// one run within the tolerance of a 1-px line's vertices. Two such
+    /// directions are 45° apart, so every step advances along the run and
+    /// no vertex is nearer the anchor than one before it: a notch's back
+    /// step ends the run, and no further test is needed for that.
+    fn advances(&mut self, step: Vec2) -> bool {
         let dir = direction(step);
         let near = (1u8 << dir) | (1u8 << ((dir + 1) % 8)) | (1u8 << ((dir + 7) % 8));
         let dirs = self.dirs | (1u8 << dir);
@@ -225,22 +238,14 @@ impl Run {
             return false;
         }
         self.dirs = dirs;
-        let d = q - self.anchor;
-        let len = d.hypot();
-        len == 0.0 || step.dot(d) > 0.1 * len * step_len
+        true
     }
 
     /// Whether the segment from the anchor to `q` is a straight run over
-    /// the vertices taken so far: it reaches (nearly) as far as every one
-    /// of them, and passes through the box of each (its direction is in
-    /// the cone).
+    /// the vertices taken so far: it passes through the box of each (its
+    /// direction is in the cone).
     fn admits(&self, q: Point) -> bool {
         let d = q - self.anchor;
-        // len + tol < farthest, without the square root.
-        let reach = self.farthest - STRAIGHT_TOLERANCE;
-        if reach > 0.0 && d.hypot2() < reach * reach {
-            return false;
-        }
         match self.cone {
             Some((r, l)) => r.cross(d) >= 0.0 && d.cross(l) >= 0.0,
             None => true,
@@ -253,28 +258,22 @@ impl Run {
     fn take(&mut self, q: Point) -> bool {
         let tol = STRAIGHT_TOLERANCE;
         let d = q - self.anchor;
-        self.farthest = self.farthest.max(d.hypot());
         if d.x.abs() <= tol && d.y.abs() <= tol {
             return true;
         }
-        // The box's corners seen from the anchor; the cone's new edges are
-        // the two outermost (the box does not contain the anchor, so they
-        // span less than 180°).
-        let corners = [
-            Vec2::new(d.x - tol, d.y - tol),
-            Vec2::new(d.x + tol, d.y - tol),
-            Vec2::new(d.x + tol, d.y + tol),
-            Vec2::new(d.x - tol, d.y + tol),
-        ];
-        let (mut right, mut left) = (corners[0], corners[0]);
-        for &c in &corners[1..] {
-            if c.cross(right) > 0.0 {
-                right = c;
-            }
-            if left.cross(c) > 0.0 {
-                left = c;
-            }
-        }
+        // The cone's new edges: the box's two corners that are outermost
+        // seen from the anchor (the box does not contain it, so they span
+        // less than 180°), picked by the signs of d as in potrace's
+        // calc_lon (right: counter-clockwise of it is admissible).
+        let sign = |c: bool| if c { tol } else { -tol };
+        let right = Vec2::new(
+            d.x + sign(d.y >= 0.0 && (d.y > 0.0 || d.x < 0.0)),
+            d.y + sign(d.x <= 0.0 && (d.x < 0.0 || d.y < 0.0)),
+        );
+        let left = Vec2::new(
+            d.x + sign(d.y <= 0.0 && (d.y < 0.0 || d.x < 0.0)),
+            d.y + sign(d.x >= 0.0 && (d.x > 0.0 || d.y < 0.0)),
+        );
         self.cone = Some(match self.cone {
             None => (right, left),
             Some((r, l)) => {
@@ -300,7 +299,7 @@ fn run_from(path: &[Point], i: usize) -> usize {
     let mut best = 1;
     for m in 1..n.min(MAX_RUN) {
         let k = (i + m) % n;
-        if !(run.advances(path[k], steps[k]) && run.admits(path[k])) {
+        if !(run.advances(steps[k].0) && run.admits(path[k])) {
             break;
         }
         best = m;
