@@ -12,23 +12,28 @@
 //!    ±½ field, ties joining the ink as everywhere in flourish), walked on
 //!    the bits ([`paths`]).
 //! 2. **Straight runs.** For every vertex `i`, the furthest vertex `j` such
-//!    that the segment `i → j` passes within [`STRAIGHT_TOLERANCE`] of every
-//!    vertex between them and every step advances along it (a cone of
-//!    admissible directions is narrowed vertex by vertex, so this is linear
-//!    in the run length). Runs are anchored at path vertices, which are
-//!    themselves up to half a pixel off the drawn edge, so on shallow
-//!    staircases they are shorter than potrace's unanchored test allows;
-//!    steps 4–5 and the curve fitter downstream make up most of that.
-//! 3. **Optimal polygon.** The fewest such segments around the loop: a
-//!    greedy jump to the furthest straight vertex is optimal from a given
-//!    start, and several starts are tried. (Steps 2–3 live in the private
-//!    module `raster::polygon`.)
-//! 4. **Vertex adjustment.** Each polygon vertex moves to the intersection
-//!    of the least-squares lines of its two edges' path vertices (their
-//!    interior ones: the ends chamfer the corner), kept within half a pixel
-//!    of where it was. Where the outline makes a U-turn over a vertex or a
-//!    short edge (the end of a line up to 3½ px wide), the turn becomes a
-//!    square cap at the farthest pixel edge (`super::line_ends`).
+//!    that a line from `i` passes through the L∞ box of half-side
+//!    [`STRAIGHT_TOLERANCE`] round every vertex between them, every step
+//!    advances along it, and the steps keep to two neighbouring directions
+//!    of the eight (potrace's straight paths, Selinger 2003, §2.2.1, as its
+//!    implementation anchors them; the direction rule keeps a run from
+//!    turning round a line's end). A cone of admissible directions is
+//!    narrowed vertex by vertex, jumping along repeated steps.
+//! 3. **Optimal polygon** (§2.2.2). Reaches made monotone (every
+//!    sub-segment of a possible segment is possible), then the fewest
+//!    segments round the loop and, of those, the least sum of potrace's
+//!    penalties (chord length × r.m.s. distance of the path from the
+//!    chord), by potrace's dynamic programme from the start whose greedy
+//!    cover is shortest. (Steps 2–3: the private module `raster::polygon`.)
+//! 4. **Vertex adjustment** (§2.3.1). Each edge gets the least-squares line
+//!    of its path vertices (the interior ones: the ends chamfer the
+//!    corner); each vertex moves to the point of the box of half-side ½
+//!    round its path vertex nearest to its two edges' lines (the private
+//!    module `raster::vertices`). Where the outline makes a U-turn over a
+//!    vertex or a short edge (the end of a line up to 3½ px wide), the turn
+//!    becomes a square cap at the farthest pixel edge; a short edge at a
+//!    sharp turn (a thin zigzag's apex) becomes a mitre, cut 1.5 px out
+//!    (`super::line_ends`).
 //! 5. **Smoothing.** Each vertex becomes either a corner or a cubic from
 //!    the midpoint of its incoming edge to the midpoint of its outgoing
 //!    edge, with control points a fraction `α` of the way to the vertex; `α`
@@ -50,7 +55,8 @@
 //! the sign and the distance agree.
 
 use crate::raster::paths::{self, Bitmap};
-use crate::raster::polygon::{optimal_polygon, Runs};
+use crate::raster::polygon::{optimal_polygon, possible_segments, straight_runs};
+use crate::raster::vertices::{adjust_vertices, edge_lines};
 use crate::raster::{line_ends, Coverage, Grid, Sdf};
 use crate::trace::contour;
 use kurbo::{CubicBez, ParamCurve, ParamCurveDeriv, Point, Vec2};
@@ -116,25 +122,15 @@ fn smooth_loop(path: &[Point]) -> SmoothLoop {
     if n < 4 {
         return polyline_loop(path);
     }
-    // Runs are computed only where the polygon search lands (memoized): a
-    // greedy cover visits a few vertices per run length, not all of them.
-    let runs = Runs::new(path);
-    let mut memo = vec![0usize; n];
-    let poly = optimal_polygon(
-        |i| {
-            if memo[i] == 0 {
-                memo[i] = runs.from(i);
-            }
-            memo[i]
-        },
-        n,
-    );
+    let ahead = possible_segments(&straight_runs(path));
+    let poly = optimal_polygon(path, &ahead);
     if poly.len() < 3 {
         return polyline_loop(path);
     }
     let lines = edge_lines(path, &poly);
     let vertices = adjust_vertices(path, &poly, &lines);
     let (vertices, caps) = line_ends::square_line_ends(path, &poly, &lines, vertices);
+    let (vertices, caps) = line_ends::mitre_short_edges(vertices, caps);
     smooth_polygon(&vertices, &caps)
 }
 
@@ -157,90 +153,6 @@ fn unit(v: Vec2) -> Vec2 {
     } else {
         Vec2::new(1.0, 0.0)
     }
-}
-
-/// The least-squares line (centroid, unit direction from the edge's start
-/// to its end) of each polygon edge's path vertices, the chamfered ends
-/// left out: edge `e` runs from `poly[e]` to `poly[e + 1]`.
-pub(super) fn edge_lines(path: &[Point], poly: &[usize]) -> Vec<(Point, Vec2)> {
-    let n = path.len();
-    let k = poly.len();
-    (0..k)
-        .map(|e| {
-            let a = poly[e];
-            let b = poly[(e + 1) % k];
-            let count = (b + n - a) % n + 1;
-            // The end vertices are where the path rounds the polygon's
-            // corners (midpoints of pixel edges chamfer every pixel corner
-            // by half a pixel): they belong to neither edge's line.
-            let at = |s: usize| path[(a + s) % n];
-            let chamfer = |end: usize, inner: usize, next: usize| {
-                let d0 = at(inner) - at(end);
-                let d1 = at(next) - at(inner);
-                let diagonal = (d0.x.abs() - 0.5).abs() < 1e-9 && (d0.y.abs() - 0.5).abs() < 1e-9;
-                let axis = (d1.x.abs() - 1.0).abs() < 1e-9 || (d1.y.abs() - 1.0).abs() < 1e-9;
-                count >= 4 && diagonal && axis
-            };
-            let first = usize::from(count >= 4 && chamfer(0, 1, 2));
-            let last = usize::from(count >= 4 && chamfer(count - 1, count - 2, count - 3));
-            let pts = (first..count - last).map(at);
-            fit_line(pts, path[a], path[b])
-        })
-        .collect()
-}
-
-/// Step 4: polygon vertices moved to where the least-squares lines of their
-/// two edges ([`edge_lines`]) meet, within half a pixel of the path vertex.
-fn adjust_vertices(path: &[Point], poly: &[usize], lines: &[(Point, Vec2)]) -> Vec<Point> {
-    let k = poly.len();
-    (0..k)
-        .map(|e| {
-            let v = path[poly[e]];
-            let (c0, d0) = lines[(e + k - 1) % k];
-            let (c1, d1) = lines[e];
-            let det = d0.cross(d1);
-            let p = if det.abs() < 1e-9 {
-                v
-            } else {
-                let t = (c1 - c0).cross(d1) / det;
-                c0 + d0 * t
-            };
-            Point::new(
-                p.x.clamp(v.x - 0.5, v.x + 0.5),
-                p.y.clamp(v.y - 0.5, v.y + 0.5),
-            )
-        })
-        .collect()
-}
-
-/// Total least squares line through `pts`: centroid and principal direction
-/// (oriented from `a` to `b`).
-fn fit_line(pts: impl Iterator<Item = Point>, a: Point, b: Point) -> (Point, Vec2) {
-    let pts: Vec<Point> = pts.collect();
-    let m = pts.len().max(1) as f64;
-    let c = pts.iter().fold(Vec2::ZERO, |s, p| s + p.to_vec2()) / m;
-    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
-    for p in &pts {
-        let d = p.to_vec2() - c;
-        sxx += d.x * d.x;
-        sxy += d.x * d.y;
-        syy += d.y * d.y;
-    }
-    let angle = 0.5 * (2.0 * sxy).atan2(sxx - syy);
-    let mut d = Vec2::new(angle.cos(), angle.sin());
-    let chord = b - a;
-    if chord.hypot() > 1e-9 && d.dot(chord) < 0.0 {
-        d = -d;
-    }
-    if pts.len() < 2 || !d.x.is_finite() {
-        let l = chord.hypot();
-        d = if l > 1e-9 {
-            chord / l
-        } else {
-            Vec2::new(1.0, 0.0)
-        };
-    }
-    (c.to_point(), d)
 }
 
 /// Step 5: corners and cubics through the edge midpoints, flattened, with

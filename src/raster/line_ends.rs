@@ -19,6 +19,12 @@
 //! (the tip lies on the pixel edge that ends the line). The cap's vertices
 //! stay corners in smoothing: the bitmap keeps a thin line's width to its
 //! last pixel, where potrace's corner measure would round the end off.
+//!
+//! And where a thin line turns sharply (a zigzag's apex), the polygon has
+//! a short edge between two half-turns that the corner measure reads as
+//! smooth: [`mitre_short_edges`] replaces it by the mitre of its long
+//! neighbours, cut square to the bisector where it would overshoot the
+//! pixels by more than [`MITRE_OUT`] (convex) or [`MITRE_IN`] (concave).
 
 use kurbo::{Point, Vec2};
 
@@ -194,6 +200,162 @@ fn cap(
     )
 }
 
+/// Longest polygon edge (px) that a mitre replaces.
+const MITRE_EDGE: f64 = 2.0;
+
+/// Farthest (px) a mitre's tip may lie from either vertex it replaces;
+/// beyond, the turn is bevelled (both vertices kept as corners).
+const MITRE_REACH: f64 = 4.0;
+
+/// Farthest (px) a mitre may reach out beyond the middle of the short edge
+/// it replaces; a longer one is cut square to its bisector there (SVG's
+/// miter limit), so an acute apex does not overshoot the pixels by more.
+const MITRE_OUT: f64 = 1.5;
+
+/// [`MITRE_OUT`] for a concave turn (the notch inside a zigzag's apex),
+/// whose tip reaches into the ink: longer, as the notch of a 1-px zigzag
+/// reaches about 2 px past its pixels' edge and stays a sharp V.
+const MITRE_IN: f64 = 2.5;
+
+/// Least and greatest turn (degrees) over a short edge that makes a mitre:
+/// less is a bend of a curve, more a U-turn (a line's end, see
+/// [`square_line_ends`]).
+const MITRE_TURN: (f64, f64) = (60.0, 150.0);
+
+/// The polygon with every short edge at a sharp turn replaced by a mitre:
+/// the apex of a thin zigzag (or the notch inside it) is a pixel or two
+/// wide in the bitmap, so the polygon has a short edge there between two
+/// vertices that each turn by half the angle; potrace's corner measure
+/// reads both as smooth and the apex comes out as a round blob. The two
+/// vertices become the point where their long neighbouring edges meet
+/// (the turn's mitre), kept as a corner. `keep` marks the corners of
+/// [`square_line_ends`]' caps, which are left alone; it is returned
+/// updated.
+pub(super) fn mitre_short_edges(v: Vec<Point>, keep: Vec<bool>) -> (Vec<Point>, Vec<bool>) {
+    let k = v.len();
+    if k < 5 || keep.len() != k {
+        return (v, keep);
+    }
+    // merged[i]: vertex i and i + 1 become this tip (or cut tip).
+    let mut merged: Vec<Option<Vec<Point>>> = vec![None; k];
+    let mut used = vec![false; k];
+    let mut bevel = vec![false; k];
+    // The loop's orientation: a turn the same way is convex.
+    let area: f64 = (0..k)
+        .map(|i| v[i].to_vec2().cross(v[(i + 1) % k].to_vec2()))
+        .sum();
+    for i in 0..k {
+        let j = (i + 1) % k;
+        if used[i] || used[j] || keep[i] || keep[j] {
+            continue;
+        }
+        let (a, p, q, b) = (v[(i + k - 1) % k], v[i], v[j], v[(i + 2) % k]);
+        let (d0, e, d1) = (p - a, q - p, b - q);
+        let short = e.hypot();
+        let side = d0.hypot().min(d1.hypot());
+        if short > MITRE_EDGE || side < MIN_SIDE.max(2.0 * short) {
+            continue;
+        }
+        // Both vertices turn the same way, by a sharp turn in all.
+        let (t0, t1) = (d0.cross(e), e.cross(d1));
+        let turn = d0.cross(d1).atan2(d0.dot(d1)).abs().to_degrees();
+        if t0 * t1 <= 0.0 || turn < MITRE_TURN.0 || turn > MITRE_TURN.1 {
+            continue;
+        }
+        // Where the lines a → p and q → b meet.
+        let det = d0.cross(d1);
+        if det.abs() < 1e-9 {
+            continue;
+        }
+        let tip = p + d0 * ((q - p).cross(d1) / det);
+        if (tip - p).hypot() > MITRE_REACH || (tip - q).hypot() > MITRE_REACH {
+            // Too far out of the pixels: a bevel, both vertices corners.
+            bevel[i] = true;
+            bevel[j] = true;
+        } else {
+            // A convex turn's tip is cut shorter (it overshoots onto the
+            // paper) than a concave one's.
+            merged[i] = Some(mitre(
+                p,
+                q,
+                tip,
+                if t0 * area > 0.0 { MITRE_OUT } else { MITRE_IN },
+            ));
+        }
+        used[i] = true;
+        used[j] = true;
+        used[(i + k - 1) % k] = true;
+        used[(i + 2) % k] = true;
+    }
+    // A single vertex at such a turn between long edges is a mitre already:
+    // kept a corner (the corner measure reads a 1-px zigzag's apex, whose
+    // neighbouring vertices sit a few pixels down the arms, as smooth).
+    for i in 0..k {
+        let (a, p, b) = (v[(i + k - 1) % k], v[i], v[(i + 1) % k]);
+        let (d0, d1) = (p - a, b - p);
+        let turn = d0.cross(d1).atan2(d0.dot(d1)).abs().to_degrees();
+        if !used[i]
+            && d0.hypot().min(d1.hypot()) >= MIN_SIDE
+            && turn >= MITRE_TURN.0
+            && turn <= MITRE_TURN.1
+        {
+            bevel[i] = true;
+        }
+    }
+    if merged.iter().all(Option::is_none) {
+        let keep = keep.iter().zip(&bevel).map(|(&a, &b)| a || b).collect();
+        return (v, keep);
+    }
+    let mut drop = vec![false; k];
+    for (i, m) in merged.iter().enumerate() {
+        if m.is_some() {
+            drop[(i + 1) % k] = true;
+        }
+    }
+    let mut out = Vec::with_capacity(k);
+    let mut corner = Vec::with_capacity(k);
+    for i in 0..k {
+        if drop[i] {
+            continue;
+        }
+        match &merged[i] {
+            Some(tip) => {
+                out.extend(tip.iter().copied());
+                corner.extend(tip.iter().map(|_| true));
+            }
+            None => {
+                out.push(v[i]);
+                corner.push(keep[i] || bevel[i]);
+            }
+        }
+    }
+    (out, corner)
+}
+
+/// The mitre over the short edge `p → q` whose neighbouring edges meet at
+/// `tip`: the tip itself, or, when it reaches more than `limit` px beyond
+/// the edge's middle, the two points where the cut square to the bisector
+/// at that distance crosses the edges' lines.
+fn mitre(p: Point, q: Point, tip: Point, limit: f64) -> Vec<Point> {
+    let m = p.midpoint(q);
+    let out = tip - m;
+    let h = out.hypot();
+    if h <= limit {
+        return vec![tip];
+    }
+    let u = out / h;
+    // On the line through `from` and the tip, the point at height MITRE_OUT
+    // along u (measured from m).
+    let cut = |from: Point| -> Point {
+        let rise = (tip - from).dot(u);
+        if rise.abs() < 1e-9 {
+            return from;
+        }
+        from + (tip - from) * ((limit - (from - m).dot(u)) / rise)
+    };
+    vec![cut(p), cut(q)]
+}
+
 #[cfg(test)]
 mod tests {
     use crate::raster::binary::smooth_loops;
@@ -296,6 +458,54 @@ mod tests {
         for s in [1.5, len - 1.5] {
             let w = width_at(s);
             assert!(w > 0.8, "{w:.2} px wide at {s:.1} px along");
+        }
+    }
+
+    /// A 1-px zigzag's apex (sides of slope ±2.5, as on the thin-lines
+    /// sample) comes out as a mitre: a corner at the outer apex, the outline never more than [`super::MITRE_OUT`]
+    /// (plus the pixel's own half) beyond the ink.
+    #[test]
+    fn a_thin_zigzag_apex_is_mitred() {
+        let apex = Point::new(20.3, 6.0);
+        let cov: Coverage = Grid::from_fn(42, 40, |x, y| {
+            let (px, py) = (x as f64 + 0.5, y as f64 + 0.5);
+            let dy = py - apex.y;
+            let arm =
+                |s: f64| ((px - apex.x) - s * dy / 2.5).abs() * 2.5 / 2.5f64.hypot(1.0) <= 0.5;
+            if (0.0..30.0).contains(&dy) && (arm(1.0) || arm(-1.0)) {
+                1.0
+            } else {
+                0.0
+            }
+        });
+        let loops = smooth_loops(&cov);
+        assert_eq!(loops.len(), 1);
+        let l = &loops[0];
+        let near_apex: Vec<Point> = l
+            .corners
+            .iter()
+            .map(|&c| l.points[c])
+            .filter(|p| (p.x - apex.x).abs() < 3.0 && p.y < apex.y + 5.0)
+            .collect();
+        assert!(!near_apex.is_empty(), "no corner at the apex");
+        let ink = |x: f64, y: f64| cov.get(x as usize, y as usize) > 0.5;
+        for p in &l.points {
+            // The nearest ink pixel, searched within 3 px.
+            let mut d = f64::INFINITY;
+            for dy in -3..=3 {
+                for dx in -3..=3 {
+                    let (cx, cy) = (p.x.floor() + dx as f64, p.y.floor() + dy as f64);
+                    if cx >= 0.0 && cy >= 0.0 && ink(cx, cy) {
+                        let r = Rect::new(cx, cy, cx + 1.0, cy + 1.0);
+                        let inside = r.contains(*p);
+                        d = d.min(if inside { 0.0 } else { to_boundary(r, *p) });
+                    }
+                }
+            }
+            assert!(
+                d <= super::MITRE_OUT + 0.5,
+                "{p:?} is {d:.2} px off the ink"
+            );
         }
     }
 }

@@ -1,36 +1,75 @@
 //! Steps 2–3 of [`crate::raster::binary`]: the straight runs of a closed
-//! path and the polygon with the fewest of them (Selinger 2003, §2.2: a
-//! path segment is straight when a line passes within
-//! [`STRAIGHT_TOLERANCE`] of its vertices; the optimal polygon, §2.2.2,
-//! here by greedy covers from several starts).
+//! path and the optimal polygon over them (Selinger 2003, §2.2).
+//!
+//! **Straight runs** (§2.2.1). potrace calls a path straight when a line
+//! passes within an L∞ box of half-side ½ round every vertex and the path
+//! does not step in all four directions. Its implementation anchors the
+//! line at the run's first vertex and narrows a cone of admissible
+//! directions by the box round each later vertex; so does [`Runs`], with
+//! boxes of half-side [`STRAIGHT_TOLERANCE`] round the vertices of
+//! flourish's paths (through pixel-edge midpoints, so they step
+//! diagonally too). The direction rule becomes: a run's steps keep to two
+//! neighbouring directions of the eight (a staircase), so a run never
+//! turns round the end of a line.
+//!
+//! **Possible segments.** Reaches are made monotone as potrace's `calc_lon`
+//! cleans them up: `i → j` is a possible edge when every vertex from `i`
+//! up to `j` has a run reaching `j`, so every sub-segment of a possible
+//! segment is possible (the shortest-path search needs this).
+//!
+//! **Optimal polygon** (§2.2.2). The fewest possible segments round the
+//! loop, and of those the one with the least sum of penalties: potrace's
+//! `P(i, j) = |p_j − p_i| · √(mean squared distance of p_i … p_j to the
+//! chord)`, read off prefix sums in constant time. As potrace does, the
+//! cycle is cut at a fixed start vertex, which every candidate contains;
+//! potrace takes the path's first vertex, here the start whose greedy
+//! cover is shortest among [`START_TRIES`] spread round the loop (a greedy
+//! cover is optimal from a fixed start on monotone reaches), so the count
+//! is never worse than the greedy polygon flourish used before. From that
+//! start, `seg0`/`seg1` bound where the `j`-th vertex can be and a dynamic
+//! programme over them finds the least total penalty (potrace's
+//! `bestpolygon`; linear in practice).
 
 use super::binary::STRAIGHT_TOLERANCE;
 use kurbo::{Point, Vec2};
-#[cfg(test)]
 use rayon::prelude::*;
 
 /// Longest straight run considered, in path vertices.
 const MAX_RUN: usize = 400;
+
+/// How many starts (spread evenly round the loop) the fewest-segment
+/// search tries before the penalty search runs from the best of them.
+pub(super) const START_TRIES: usize = 32;
 
 /// Step 2: `lon[i]` = how many vertices ahead of `i` a straight run from `i`
 /// reaches (at least 1).
 ///
 /// The path's steps come in few directions, and long stretches repeat one
 /// (a pixel edge, a 45° staircase of edge midpoints). Along such a stretch
-/// every test below is settled by its two ends: a point's distance to a
-/// line is affine along a straight stretch, the cone of admissible
-/// directions is an angular interval, and a stretch that advances keeps
-/// advancing. So the walk jumps from stretch end to stretch end and only
-/// steps vertex by vertex through the stretch where the run ends. The
-/// result is the same as [`run_from`] applied at every vertex (tested).
-#[cfg(test)]
-fn straight_runs(path: &[Point]) -> Vec<usize> {
+/// every test below is settled by its two ends: a vertex's L∞ distance
+/// from a line through the anchor is affine along a straight stretch, the
+/// cone of admissible directions is an angular interval, and a stretch
+/// steps in one direction. So the walk jumps from stretch
+/// end to stretch end and only steps vertex by vertex through the stretch
+/// where the run ends. The result is the same as [`run_from`] applied at
+/// every vertex (tested).
+pub(super) fn straight_runs(path: &[Point]) -> Vec<usize> {
     let runs = Runs::new(path);
-    (0..path.len())
-        .into_par_iter()
-        .map(|i| runs.from(i))
-        .collect()
+    if path.len() >= PARALLEL_RUNS {
+        // A long loop (an ornament's outline holds most of its vertices)
+        // is split across threads; the runs are collected in order.
+        (0..path.len())
+            .into_par_iter()
+            .with_min_len(PARALLEL_RUNS / 2)
+            .map(|i| runs.from(i))
+            .collect()
+    } else {
+        (0..path.len()).map(|i| runs.from(i)).collect()
+    }
 }
+
+/// Loops with at least this many vertices compute their runs in parallel.
+const PARALLEL_RUNS: usize = 4096;
 
 /// What the straight-run walk needs of a path, computed once: its steps and
 /// how far each step repeats. [`Runs::from`] is then one vertex's run, so
@@ -93,7 +132,7 @@ impl<'a> Runs<'a> {
                 // The stretch's first step must advance, and its end must
                 // pass; then every vertex between passes too.
                 let first = (j + 1) % n;
-                if !run.advances(path[first], steps[first]) {
+                if !run.advances(steps[first].0) {
                     break;
                 }
                 if run.admits(path[e]) {
@@ -113,7 +152,7 @@ impl<'a> Runs<'a> {
                     break;
                 }
                 let k = (j + 1) % n;
-                if !(run.advances(path[k], steps[k]) && run.admits(path[k])) {
+                if !(run.advances(steps[k].0) && run.admits(path[k])) {
                     ended = true;
                     break;
                 }
@@ -144,14 +183,32 @@ fn path_steps(path: &[Point]) -> Vec<(Vec2, f64)> {
         .collect()
 }
 
+/// Which of eight directions, 45° apart (0 along +x, counting towards
+/// +y), a step of a path points in; from the signs of its components
+/// (a path's steps are along an axis or diagonal).
+fn direction(step: Vec2) -> u32 {
+    let sx = (step.x > 1e-9) as i32 - (step.x < -1e-9) as i32;
+    let sy = (step.y > 1e-9) as i32 - (step.y < -1e-9) as i32;
+    match (sx, sy) {
+        (1, 0) => 0,
+        (1, 1) => 1,
+        (0, 1) => 2,
+        (-1, 1) => 3,
+        (-1, 0) => 4,
+        (-1, -1) => 5,
+        (0, -1) => 6,
+        _ => 7,
+    }
+}
+
 /// The state of one straight run from an anchor vertex.
 struct Run {
     anchor: Point,
     /// The cone of admissible directions, as its right and left edge
     /// vectors (counter-clockwise from right to left); None = any.
     cone: Option<(Vec2, Vec2)>,
-    /// The farthest distance from the anchor of a vertex taken so far.
-    farthest: f64,
+    /// The directions (of eight) of the steps taken so far, as bits.
+    dirs: u8,
 }
 
 impl Run {
@@ -159,30 +216,36 @@ impl Run {
         Run {
             anchor,
             cone: None,
-            farthest: 0.0,
+            dirs: 0,
         }
     }
 
-    /// Every step must advance along the run: a step across it (the end
-    /// cap of a line, a notch) ends the run, or runs would cut such corners
-    /// while staying within tolerance of every vertex.
-    fn advances(&self, q: Point, (step, step_len): (Vec2, f64)) -> bool {
-        let d = q - self.anchor;
-        let len = d.hypot();
-        len == 0.0 || step.dot(d) > 0.1 * len * step_len
+    /// Whether the step into `q` may join the run; records its direction.
+    ///
+    /// The steps of a run keep to two neighbouring directions of the eight
+    /// (potrace's rule that a straight path never steps in all four
+    /// directions, for paths that also step diagonally): a run does not
+    /// turn round the end of a line, whose two sides would otherwise be
+    /// one run within the tolerance of a 1-px line's vertices. Two such
+    /// directions are 45° apart, so every step advances along the run and
+    /// no vertex is nearer the anchor than one before it: a notch's back
+    /// step ends the run, and no further test is needed for that.
+    fn advances(&mut self, step: Vec2) -> bool {
+        let dir = direction(step);
+        let near = (1u8 << dir) | (1u8 << ((dir + 1) % 8)) | (1u8 << ((dir + 7) % 8));
+        let dirs = self.dirs | (1u8 << dir);
+        if self.dirs & !near != 0 || dirs.count_ones() > 2 {
+            return false;
+        }
+        self.dirs = dirs;
+        true
     }
 
     /// Whether the segment from the anchor to `q` is a straight run over
-    /// the vertices taken so far: it reaches (nearly) as far as every one
-    /// of them, and passes within the tolerance of each (its direction is
-    /// in the cone).
+    /// the vertices taken so far: it passes through the box of each (its
+    /// direction is in the cone).
     fn admits(&self, q: Point) -> bool {
         let d = q - self.anchor;
-        // len + tol < farthest, without the square root.
-        let reach = self.farthest - STRAIGHT_TOLERANCE;
-        if reach > 0.0 && d.hypot2() < reach * reach {
-            return false;
-        }
         match self.cone {
             Some((r, l)) => r.cross(d) >= 0.0 && d.cross(l) >= 0.0,
             None => true,
@@ -190,22 +253,27 @@ impl Run {
     }
 
     /// Takes `q` into the run, narrowing the cone to the directions that
-    /// pass within the tolerance of it; false when nothing is left beyond.
+    /// pass through the box of half-side [`STRAIGHT_TOLERANCE`] round it;
+    /// false when nothing is left beyond.
     fn take(&mut self, q: Point) -> bool {
         let tol = STRAIGHT_TOLERANCE;
         let d = q - self.anchor;
-        let len = d.hypot();
-        self.farthest = self.farthest.max(len);
-        if len <= tol {
+        if d.x.abs() <= tol && d.y.abs() <= tol {
             return true;
         }
-        // The half-angle a of the cone: sin a = tol / len. The edges are
-        // d turned by ±a, scaled by len (only their directions matter):
-        // len·cos a = √(len² − tol²), len·sin a = tol.
-        let c = (len * len - tol * tol).sqrt() / len;
-        let s = tol / len;
-        let right = Vec2::new(d.x * c + d.y * s, -d.x * s + d.y * c);
-        let left = Vec2::new(d.x * c - d.y * s, d.x * s + d.y * c);
+        // The cone's new edges: the box's two corners that are outermost
+        // seen from the anchor (the box does not contain it, so they span
+        // less than 180°), picked by the signs of d as in potrace's
+        // calc_lon (right: counter-clockwise of it is admissible).
+        let sign = |c: bool| if c { tol } else { -tol };
+        let right = Vec2::new(
+            d.x + sign(d.y >= 0.0 && (d.y > 0.0 || d.x < 0.0)),
+            d.y + sign(d.x <= 0.0 && (d.x < 0.0 || d.y < 0.0)),
+        );
+        let left = Vec2::new(
+            d.x + sign(d.y <= 0.0 && (d.y < 0.0 || d.x < 0.0)),
+            d.y + sign(d.x >= 0.0 && (d.x > 0.0 || d.y < 0.0)),
+        );
         self.cone = Some(match self.cone {
             None => (right, left),
             Some((r, l)) => {
@@ -231,7 +299,7 @@ fn run_from(path: &[Point], i: usize) -> usize {
     let mut best = 1;
     for m in 1..n.min(MAX_RUN) {
         let k = (i + m) % n;
-        if !(run.advances(path[k], steps[k]) && run.admits(path[k])) {
+        if !(run.advances(steps[k].0) && run.admits(path[k])) {
             break;
         }
         best = m;
@@ -242,19 +310,49 @@ fn run_from(path: &[Point], i: usize) -> usize {
     best
 }
 
-/// Step 3: the polygon with fewest straight edges, as path indices in order.
-pub(super) fn optimal_polygon(mut lon: impl FnMut(usize) -> usize, n: usize) -> Vec<usize> {
-    // The greedy cover from `start`: how many vertices it has, counting up
-    // to `limit` at most, and them in order into `out` when given.
-    let mut cover = |start: usize, limit: usize, mut out: Option<&mut Vec<usize>>| -> usize {
-        if let Some(o) = out.as_deref_mut() {
-            o.push(start);
+/// Possible segments: `ahead[i]` = how many vertices ahead of `i` the
+/// longest possible segment from `i` ends, `lon` cleaned up as potrace's
+/// `calc_lon` does (`ahead[i] = min(lon[i], ahead[i + 1] + 1)` round the
+/// loop), so that `i → j` possible implies every `i' → j'` inside it is.
+/// At most `(n − 1) / 2` when the loop would otherwise close in two
+/// segments (a polygon needs three).
+pub(super) fn possible_segments(lon: &[usize]) -> Vec<usize> {
+    let n = lon.len();
+    let mut ahead: Vec<usize> = lon.iter().map(|&l| l.clamp(1, n.max(2) - 1)).collect();
+    if n < 2 {
+        return ahead;
+    }
+    // Two passes backwards round the loop settle the wrap: a reach is
+    // shorter than the loop, so a constraint travels less than once round.
+    for _ in 0..2 {
+        for i in (0..n).rev() {
+            let next = ahead[(i + 1) % n] + 1;
+            if next < ahead[i] {
+                ahead[i] = next;
+            }
         }
+    }
+    if n >= 4 && fewest_start(&ahead).1 < 3 {
+        let cap = (n - 1) / 2;
+        for a in ahead.iter_mut() {
+            *a = (*a).min(cap);
+        }
+    }
+    ahead
+}
+
+/// The start (of [`START_TRIES`] spread round the loop) whose greedy
+/// cover has the fewest segments, and that count: the first such start.
+pub(super) fn fewest_start(ahead: &[usize]) -> (usize, usize) {
+    let n = ahead.len();
+    // The greedy cover from `start`: how many segments it has, counting up
+    // to `limit` at most.
+    let cover = |start: usize, limit: usize| -> usize {
         let mut count = 1;
         let mut at = 0usize; // steps from start
         let mut i = start; // (start + at) mod n
         while count < limit {
-            let step = lon(i).max(1);
+            let step = ahead[i].max(1);
             at += step;
             if at >= n {
                 break;
@@ -264,60 +362,150 @@ pub(super) fn optimal_polygon(mut lon: impl FnMut(usize) -> usize, n: usize) -> 
             if i >= n {
                 i -= n;
             }
-            if let Some(o) = out.as_deref_mut() {
-                o.push(i);
-            }
             count += 1;
         }
         count
     };
-    // The first start with the fewest vertices; a cover stops counting as
-    // soon as it cannot beat the best so far.
-    let tries = n.min(32);
-    let mut best: Option<(usize, usize)> = None;
+    // A cover stops counting as soon as it cannot beat the best so far.
+    let tries = n.min(START_TRIES);
+    let mut best = (0, usize::MAX);
     for k in 0..tries {
         let start = k * n / tries;
-        let limit = best.map_or(usize::MAX, |b| b.1);
-        let count = cover(start, limit, None);
-        if count < limit {
-            best = Some((start, count));
+        let count = cover(start, best.1);
+        if count < best.1 {
+            best = (start, count);
         }
     }
-    let mut out = Vec::new();
-    if let Some((start, count)) = best {
-        out.reserve(count);
-        cover(start, usize::MAX, Some(&mut out));
-    }
-    out
+    best
 }
 
-/// [`optimal_polygon`] as first written: every cover built in full, the
-/// first of fewest vertices kept. The reference the counting search must
-/// agree with.
-#[cfg(test)]
-fn optimal_polygon_reference(mut lon: impl FnMut(usize) -> usize, n: usize) -> Vec<usize> {
-    let mut cover = |start: usize| -> Vec<usize> {
-        let mut out = vec![start];
-        let mut at = 0usize;
-        while at < n {
-            let step = lon((start + at) % n).max(1);
-            at += step;
-            if at >= n {
-                break;
-            }
-            out.push((start + at) % n);
+/// Prefix sums of the path's coordinates (relative to the start vertex,
+/// taken `start`-first round the loop and back to it), for potrace's
+/// penalty in constant time.
+struct Sums {
+    /// `s[t]`: sums of x, y, x², xy, y² over the first `t` vertices.
+    s: Vec<[f64; 5]>,
+    /// The vertices, relative to the start, `n + 1` of them (the start
+    /// again last).
+    q: Vec<Vec2>,
+}
+
+impl Sums {
+    fn new(path: &[Point], start: usize) -> Self {
+        let n = path.len();
+        let q: Vec<Vec2> = (0..=n)
+            .map(|t| path[(start + t) % n] - path[start])
+            .collect();
+        let mut s = Vec::with_capacity(n + 2);
+        let mut acc = [0.0; 5];
+        s.push(acc);
+        for v in &q {
+            acc[0] += v.x;
+            acc[1] += v.y;
+            acc[2] += v.x * v.x;
+            acc[3] += v.x * v.y;
+            acc[4] += v.y * v.y;
+            s.push(acc);
         }
-        out
-    };
-    let tries = n.min(32);
-    let mut best: Option<Vec<usize>> = None;
-    for k in 0..tries {
-        let poly = cover(k * n / tries);
-        if best.as_ref().is_none_or(|b| poly.len() < b.len()) {
-            best = Some(poly);
+        Sums { s, q }
+    }
+
+    /// potrace's penalty of the segment from relative vertex `i` to `j`
+    /// (`i < j ≤ n`): the chord's length times the root mean square
+    /// distance of the vertices `i ..= j` from the chord's line (Selinger
+    /// 2003, §2.2.2), px².
+    fn penalty(&self, i: usize, j: usize) -> f64 {
+        let (Some(a), Some(b)) = (self.s.get(i), self.s.get(j + 1)) else {
+            return f64::INFINITY;
+        };
+        let (Some(&p), Some(&r)) = (self.q.get(i), self.q.get(j)) else {
+            return f64::INFINITY;
+        };
+        let cnt = (j + 1 - i) as f64;
+        let [sx, sy, sxx, sxy, syy] = [
+            b[0] - a[0],
+            b[1] - a[1],
+            b[2] - a[2],
+            b[3] - a[3],
+            b[4] - a[4],
+        ];
+        let m = (p + r) * 0.5;
+        let e = r - p;
+        // Σ (e × (v − m))² = e_x² Σ(y − m_y)² − 2 e_x e_y Σ(x − m_x)(y − m_y)
+        // + e_y² Σ(x − m_x)².
+        let cxx = sxx - 2.0 * m.x * sx + cnt * m.x * m.x;
+        let cxy = sxy - m.x * sy - m.y * sx + cnt * m.x * m.y;
+        let cyy = syy - 2.0 * m.y * sy + cnt * m.y * m.y;
+        let s = e.x * e.x * cyy - 2.0 * e.x * e.y * cxy + e.y * e.y * cxx;
+        (s.max(0.0) / cnt).sqrt()
+    }
+}
+
+/// Step 3: the optimal polygon over the possible segments `ahead` (see
+/// [`possible_segments`]) of the closed `path`, as path indices in order
+/// from the start vertex: the fewest segments from the start, and of those
+/// the least total penalty (module docs; potrace's `bestpolygon`).
+pub(super) fn optimal_polygon(path: &[Point], ahead: &[usize]) -> Vec<usize> {
+    let n = path.len();
+    if n < 3 || ahead.len() != n {
+        return (0..n).collect();
+    }
+    let (start, _) = fewest_start(ahead);
+    let sums = Sums::new(path, start);
+    // clip0[i]: the farthest vertex a segment from i reaches; clip1[j]: the
+    // nearest vertex a segment into j can start from (relative indices,
+    // the start at 0 and again at n). Both are nondecreasing.
+    let clip0: Vec<usize> = (0..n)
+        .map(|i| (i + ahead[(start + i) % n].max(1)).min(n))
+        .collect();
+    let mut clip1 = vec![0usize; n + 1];
+    let mut i = 0;
+    for (j, c) in clip1.iter_mut().enumerate().skip(1) {
+        while clip0.get(i).is_some_and(|&c0| c0 < j) {
+            i += 1;
+        }
+        *c = i;
+    }
+    // seg0[j]: the farthest vertex j segments reach from 0; seg1[j]: the
+    // nearest vertex from which n is reached in m − j segments.
+    let mut seg0 = vec![0usize];
+    let mut at = 0;
+    while at < n {
+        at = clip0.get(at).copied().unwrap_or(n);
+        seg0.push(at);
+    }
+    let m = seg0.len() - 1;
+    let mut seg1 = vec![0usize; m + 1];
+    seg1[m] = n;
+    for j in (1..=m).rev() {
+        seg1[j - 1] = clip1.get(seg1[j]).copied().unwrap_or(0);
+    }
+    // pen[i]: the least total penalty of j segments from 0 to i, for i in
+    // seg1[j] ..= seg0[j] (these ranges are disjoint for different j, as
+    // in potrace); prev[i]: the vertex before i on that polygon.
+    let mut pen = vec![f64::INFINITY; n + 1];
+    let mut prev = vec![0usize; n + 1];
+    pen[0] = 0.0;
+    for j in 1..=m {
+        for i in seg1[j]..=seg0[j].min(n) {
+            let lo = clip1[i].max(seg1[j - 1]);
+            for k in (lo..=seg0[j - 1].min(i.saturating_sub(1))).rev() {
+                let p = pen[k] + sums.penalty(k, i);
+                if p < pen[i] {
+                    pen[i] = p;
+                    prev[i] = k;
+                }
+            }
         }
     }
-    best.unwrap_or_default()
+    let mut out = Vec::with_capacity(m);
+    let mut i = n;
+    for _ in 0..m {
+        i = prev[i];
+        out.push((start + i) % n);
+    }
+    out.reverse();
+    out
 }
 
 #[cfg(test)]
@@ -327,34 +515,99 @@ mod tests {
     use crate::raster::Grid;
     use crate::trace::contour;
 
+    /// Every polygon round `n` vertices containing `start` (exhaustively,
+    /// over vertex subsets) whose segments are possible under `ahead`:
+    /// the fewest segments and, of those, the least total penalty.
+    fn brute_force(path: &[Point], ahead: &[usize], start: Option<usize>) -> (usize, f64) {
+        let n = path.len();
+        let mut best = (usize::MAX, f64::INFINITY);
+        for mask in 1u32..(1 << n) {
+            if start.is_some_and(|s| mask & (1 << s) == 0) {
+                continue;
+            }
+            let vs: Vec<usize> = (0..n).filter(|&v| mask & (1 << v) != 0).collect();
+            let sums = Sums::new(path, vs[0]);
+            let mut pen = 0.0;
+            let mut ok = true;
+            for (e, &a) in vs.iter().enumerate() {
+                let b = vs.get(e + 1).copied().unwrap_or(vs[0] + n);
+                if b - a > ahead[a] {
+                    ok = false;
+                    break;
+                }
+                pen += sums.penalty(a - vs[0], b - vs[0]);
+            }
+            if ok && (vs.len() < best.0 || (vs.len() == best.0 && pen < best.1 - 1e-12)) {
+                best = (vs.len(), pen);
+            }
+        }
+        best
+    }
+
     proptest::proptest! {
-        /// The counting search picks the same polygon as building every
-        /// cover in full, for any run lengths (ties between starts, runs
-        /// reaching past the start, runs of one).
+        /// The dynamic programme finds the polygon the exhaustive search
+        /// over vertex subsets finds: from its start vertex, the same
+        /// fewest segments and least total penalty; and (all starts tried
+        /// on loops this small) no polygon at all has fewer segments.
         #[test]
-        fn counted_covers_pick_the_reference_polygon(
-            lon in proptest::collection::vec(1usize..12, 1..200),
-            long in proptest::collection::vec(1usize..400, 0..4),
+        fn penalty_polygon_equals_exhaustive_search(
+            pts in proptest::collection::vec((0.0f64..10.0, 0.0f64..10.0), 4..13),
+            lon in proptest::collection::vec(1usize..8, 13),
         ) {
-            let mut lon = lon;
-            let n = lon.len();
-            for (k, &m) in long.iter().enumerate() {
-                let at = k * 37 % n;
-                lon[at] = m.min(n.saturating_sub(1)).max(1);
+            let path: Vec<Point> = pts.iter().map(|&(x, y)| Point::new(x, y)).collect();
+            let n = path.len();
+            let ahead = possible_segments(&lon[..n]);
+            // Monotone: a possible segment's sub-segments are possible.
+            for i in 0..n {
+                proptest::prop_assert!(ahead[i] <= ahead[(i + 1) % n] + 1);
+                proptest::prop_assert!(ahead[i] >= 1 && ahead[i] <= lon[i].max(1));
             }
-            for l in lon.iter_mut() {
-                *l = (*l).min(n.saturating_sub(1)).max(1);
+            let poly = optimal_polygon(&path, &ahead);
+            let start = poly[0];
+            let sums = Sums::new(&path, start);
+            let mut pen = 0.0;
+            for (e, &a) in poly.iter().enumerate() {
+                let b = poly.get(e + 1).copied().unwrap_or(start);
+                let (ra, rb) = ((a + n - start) % n, (b + n - start) % n);
+                let rb = if rb == 0 { n } else { rb };
+                proptest::prop_assert!(rb > ra && rb - ra <= ahead[a], "segment {a} -> {b}");
+                pen += sums.penalty(ra, rb);
             }
-            proptest::prop_assert_eq!(
-                optimal_polygon(|i| lon[i], n),
-                optimal_polygon_reference(|i| lon[i], n)
-            );
+            let (count, best) = brute_force(&path, &ahead, Some(start));
+            proptest::prop_assert_eq!(poly.len(), count);
+            proptest::prop_assert!((pen - best).abs() < 1e-6, "{} vs {}", pen, best);
+            proptest::prop_assert_eq!(brute_force(&path, &ahead, None).0, count);
+        }
+
+        /// The penalty read off prefix sums is the chord length times the
+        /// root mean square distance of the vertices from the chord.
+        #[test]
+        fn penalty_from_sums_is_direct(
+            pts in proptest::collection::vec((-50.0f64..50.0, -50.0f64..50.0), 3..30),
+            start in 0usize..30, i in 0usize..30, len in 1usize..30,
+        ) {
+            let path: Vec<Point> = pts.iter().map(|&(x, y)| Point::new(x, y)).collect();
+            let n = path.len();
+            let (start, i) = (start % n, i % n);
+            let j = (i + len).min(n);
+            proptest::prop_assume!(j > i);
+            let sums = Sums::new(&path, start);
+            let at = |t: usize| path[(start + t) % n];
+            let e = at(j) - at(i);
+            let m = at(i).midpoint(at(j));
+            let direct = ((i..=j).map(|t| e.cross(at(t) - m).powi(2)).sum::<f64>()
+                / (j + 1 - i) as f64)
+                .sqrt();
+            // Squares compared: the sums cancel to within rounding of
+            // |e|² times the coordinates' squares (100² here).
+            let p = sums.penalty(i, j);
+            proptest::prop_assert!((p * p - direct * direct).abs() < 1e-8 * (1.0 + e.hypot2()) * 1e4);
         }
     }
 
     /// The stretch-jumping walk gives the vertex-by-vertex runs exactly,
     /// on the loops of random blobs (every kind of staircase and corner),
-    /// and the polygon search the reference's polygon.
+    /// and every run is straight by the definition.
     #[test]
     fn jumping_runs_equal_the_vertex_by_vertex_reference() {
         let mut seed = 0x9e3779b97f4a7c15u64;
@@ -394,10 +647,29 @@ mod tests {
                     assert_eq!(lon, run_from(path, i), "vertex {i} of {}", path.len());
                     checked += 1;
                 }
-                assert_eq!(
-                    optimal_polygon(|i| fast[i], path.len()),
-                    optimal_polygon_reference(|i| fast[i], path.len())
-                );
+                // Every run is straight by the definition itself: the
+                // chord passes through the box round every vertex, and the
+                // steps keep to two neighbouring directions.
+                let n = path.len();
+                for (i, &m) in fast.iter().enumerate() {
+                    let d = path[(i + m) % n] - path[i];
+                    let l1 = d.x.abs() + d.y.abs();
+                    let mut dirs = 0u8;
+                    for k in 1..=m {
+                        let q = path[(i + k) % n] - path[i];
+                        assert!(d.cross(q).abs() <= STRAIGHT_TOLERANCE * l1 + 1e-9);
+                        dirs |= 1 << direction(path[(i + k) % n] - path[(i + k + n - 1) % n]);
+                    }
+                    assert!(
+                        dirs.count_ones() <= 2
+                            && (dirs.count_ones() < 2 || {
+                                let lo = dirs.trailing_zeros();
+                                let hi = 7 - dirs.leading_zeros();
+                                hi - lo == 1 || (lo == 0 && hi == 7)
+                            }),
+                        "run {i}+{m} steps in directions {dirs:08b}"
+                    );
+                }
             }
         }
         assert!(checked > 5000, "only {checked} vertices");
@@ -429,16 +701,17 @@ mod tests {
         }
         let longest = lon.iter().copied().max().unwrap_or(0);
         assert!(longest >= 8, "longest run {longest} of {n}");
-        // Straight means: every vertex within the tolerance of the chord.
+        // Straight means: the chord passes through the box round every
+        // vertex (L∞ distance from its line within the tolerance).
         for (i, &m) in lon.iter().enumerate() {
-            let chord = kurbo::Line::new(path[i], path[(i + m) % n]);
+            let d = path[(i + m) % n] - path[i];
             for k in 0..=m {
-                let d = crate::raster::sdf::point_segment_distance(path[(i + k) % n], chord);
-                assert!(d <= STRAIGHT_TOLERANCE + 1e-9, "run {i}+{m}: {d}");
+                let off = d.cross(path[(i + k) % n] - path[i]).abs() / (d.x.abs() + d.y.abs());
+                assert!(off <= STRAIGHT_TOLERANCE + 1e-9, "run {i}+{m}: {off}");
             }
         }
         // The polygon needs far fewer vertices than the path.
-        let poly = optimal_polygon(|i| lon[i], n);
+        let poly = optimal_polygon(path, &possible_segments(&lon));
         assert!(poly.len() * 5 <= n, "{} vertices of {n}", poly.len());
         // And the smoothed outline stays within half a pixel (plus the
         // rounding of the band's four corners) of the drawn band's edges.
