@@ -34,8 +34,16 @@ use super::binary::STRAIGHT_TOLERANCE;
 use kurbo::{Point, Vec2};
 use rayon::prelude::*;
 
-/// Longest straight run considered, in path vertices.
-const MAX_RUN: usize = 400;
+/// Longest straight run considered, in path vertices (about 50–70 px of
+/// outline). The penalty search needs a run at every vertex and a walk
+/// costs its length: at 400 the runs took 1.3 G instructions per trace of
+/// the 2 Mpx ornament (callgrind), more than all the rest; at 100, 0.4 G.
+/// Longer runs buy nothing downstream (a straight edge cut in two gets a
+/// smooth vertex on its line, and the curve fitter spans it): at 100 the
+/// 2 Mpx ornament traces byte for byte as at 400 and the binary samples
+/// need the same segments. At 64 a 1.5-px diagonal loses a tenth of its
+/// weight (`binary_hairlines_keep_their_weight`).
+const MAX_RUN: usize = 100;
 
 /// How many starts (spread evenly round the loop) the fewest-segment
 /// search tries before the penalty search runs from the best of them.
@@ -76,7 +84,8 @@ const PARALLEL_RUNS: usize = 4096;
 /// the polygon search (step 3) computes runs only at the vertices it visits.
 pub(super) struct Runs<'a> {
     path: &'a [Point],
-    steps: Vec<(Vec2, f64)>,
+    /// The direction (of eight, [`direction`]) of the step into each vertex.
+    dirs: Vec<u8>,
     /// `stretch[k]`: how many vertices ahead of `k` the step into `k + 1`
     /// keeps repeating (at least 1).
     stretch: Vec<usize>,
@@ -111,7 +120,7 @@ impl<'a> Runs<'a> {
         }
         Runs {
             path,
-            steps,
+            dirs: steps.iter().map(|s| direction(s.0) as u8).collect(),
             stretch,
         }
     }
@@ -119,20 +128,20 @@ impl<'a> Runs<'a> {
     /// `lon[i]`: how many vertices ahead of `i` the straight run from `i`
     /// reaches (at least 1).
     pub(super) fn from(&self, i: usize) -> usize {
-        let (path, steps, stretch) = (self.path, &self.steps, &self.stretch);
+        let (path, dirs, stretch) = (self.path, &self.dirs, &self.stretch);
         let n = path.len();
         let limit = n.min(MAX_RUN);
+        let wrap = |k: usize| if k >= n { k - n } else { k };
         let mut run = Run::new(path[i]);
         let mut j = i;
         let mut m = 0usize;
         loop {
             let ahead = stretch[j];
-            let e = (j + ahead) % n;
             if ahead >= 2 && m + ahead < limit {
                 // The stretch's first step must advance, and its end must
                 // pass; then every vertex between passes too.
-                let first = (j + 1) % n;
-                if !run.advances(steps[first].0) {
+                let e = wrap(j + ahead);
+                if !run.advances(dirs[wrap(j + 1)]) {
                     break;
                 }
                 if run.admits(path[e]) {
@@ -151,8 +160,8 @@ impl<'a> Runs<'a> {
                     ended = true;
                     break;
                 }
-                let k = (j + 1) % n;
-                if !(run.advances(steps[k].0) && run.admits(path[k])) {
+                let k = wrap(j + 1);
+                if !(run.advances(dirs[k]) && run.admits(path[k])) {
                     ended = true;
                     break;
                 }
@@ -230,10 +239,10 @@ impl Run {
     /// directions are 45° apart, so every step advances along the run and
     /// no vertex is nearer the anchor than one before it: a notch's back
     /// step ends the run, and no further test is needed for that.
-    fn advances(&mut self, step: Vec2) -> bool {
-        let dir = direction(step);
-        let near = (1u8 << dir) | (1u8 << ((dir + 1) % 8)) | (1u8 << ((dir + 7) % 8));
-        let dirs = self.dirs | (1u8 << dir);
+    fn advances(&mut self, dir: u8) -> bool {
+        let bit = 1u8 << dir;
+        let near = bit | bit.rotate_left(1) | bit.rotate_right(1);
+        let dirs = self.dirs | bit;
         if self.dirs & !near != 0 || dirs.count_ones() > 2 {
             return false;
         }
@@ -299,7 +308,7 @@ fn run_from(path: &[Point], i: usize) -> usize {
     let mut best = 1;
     for m in 1..n.min(MAX_RUN) {
         let k = (i + m) % n;
-        if !(run.advances(steps[k].0) && run.admits(path[k])) {
+        if !(run.advances(direction(steps[k].0) as u8) && run.admits(path[k])) {
             break;
         }
         best = m;
