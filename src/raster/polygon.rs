@@ -35,14 +35,14 @@ use kurbo::{Point, Vec2};
 use rayon::prelude::*;
 
 /// Longest straight run considered, in path vertices (about 50–70 px of
-/// outline). The penalty search needs a run at every vertex and a walk
-/// costs its length: at 400 the runs took 1.3 G instructions per trace of
-/// the 2 Mpx ornament (callgrind), more than all the rest; at 100, 0.4 G.
-/// Longer runs buy nothing downstream (a straight edge cut in two gets a
-/// smooth vertex on its line, and the curve fitter spans it): at 100 the
-/// 2 Mpx ornament traces byte for byte as at 400 and the binary samples
-/// need the same segments. At 64 a 1.5-px diagonal loses a tenth of its
-/// weight (`binary_hairlines_keep_their_weight`).
+/// outline). The penalty search's work grows with the runs' lengths: per
+/// trace of the 2 Mpx ornament (callgrind) it costs 174 M instructions at
+/// 400 and 114 M at 100. Longer runs buy nothing downstream (a straight
+/// edge cut in two gets a smooth vertex on its line, and the curve fitter
+/// spans it): at 100 the 2 Mpx ornament traces byte for byte as at 400
+/// and the binary samples need the same segments. At 64 a 1.5-px
+/// diagonal loses a tenth of its weight
+/// (`binary_hairlines_keep_their_weight`).
 const MAX_RUN: usize = 100;
 
 /// How many starts (spread evenly round the loop) the fewest-segment
@@ -137,17 +137,20 @@ impl<'a> Runs<'a> {
         let mut m = 0usize;
         loop {
             let ahead = stretch[j];
-            if ahead >= 2 && m + ahead < limit {
-                // The stretch's first step must advance, and its end must
-                // pass; then every vertex between passes too.
-                let e = wrap(j + ahead);
+            // As far along the stretch as the run may go: its end, or the
+            // cap (a long straight edge reaches it from every vertex).
+            let reach = ahead.min(limit - 1 - m);
+            if reach >= 2 {
+                // The stretch's first step must advance, and the vertex
+                // reached must pass; then every vertex between passes too.
+                let e = wrap(j + reach);
                 if !run.advances(dirs[wrap(j + 1)]) {
                     break;
                 }
                 if run.admits(path[e]) {
-                    m += ahead;
+                    m += reach;
                     j = e;
-                    if !run.take(path[e]) {
+                    if !run.take(path[e]) || m + 1 >= limit {
                         break;
                     }
                     continue;
@@ -682,6 +685,32 @@ mod tests {
             }
         }
         assert!(checked > 5000, "only {checked} vertices");
+    }
+
+    /// Along an edge longer than [`MAX_RUN`] vertices (a bar 300 px
+    /// long), every run stops at the cap, jumping there in one step, and
+    /// agrees with the vertex-by-vertex reference.
+    #[test]
+    fn runs_along_a_long_edge_stop_at_the_cap() {
+        let cov = Grid::from_fn(320, 12, |x, y| {
+            if (10..310).contains(&x) && (4..8).contains(&y) {
+                1.0
+            } else {
+                0.0
+            }
+        });
+        let values = cov.map(|c| if c >= 0.5 { -0.5 } else { 0.5 });
+        let cs = contour::extract(&values);
+        assert_eq!(cs.len(), 1);
+        let path = &cs[0].points;
+        let runs = Runs::new(path);
+        let mut capped = 0;
+        for i in 0..path.len() {
+            let lon = runs.from(i);
+            assert_eq!(lon, run_from(path, i), "vertex {i}");
+            capped += usize::from(lon == MAX_RUN - 1);
+        }
+        assert!(capped > 300, "{capped} runs reach the cap");
     }
 
     #[test]
