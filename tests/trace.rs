@@ -353,9 +353,9 @@ fn hairlines_keep_their_weight_in_layers() {
     });
 }
 
-fn hairlines_keep_their_weight_with(input: &InputOptions) {
-    use kurbo::Shape;
-    let png = root().join("samples/trace/thin-lines.png");
+/// The thin-lines sample's twenty drawn lines (the first twenty subpaths
+/// of its SVG), in pixel coordinates.
+fn thin_lines_drawn() -> Vec<kurbo::BezPath> {
     let svg = std::fs::read_to_string(root().join("samples/trace/thin-lines.svg")).expect("svg");
     let truth: Vec<kurbo::BezPath> = svg
         .split(" d=\"")
@@ -363,14 +363,25 @@ fn hairlines_keep_their_weight_with(input: &InputOptions) {
         .filter_map(|s| s.split('"').next())
         .map(|d| kurbo::BezPath::from_svg(d).expect("truth path"))
         .collect();
-    let lines: Vec<kurbo::BezPath> = subpaths(&truth).into_iter().take(20).collect();
-    let doc = trace_file(&png, input, &TraceOptions::default()).expect("traces");
-    let traced: Vec<kurbo::BezPath> = subpaths(
+    subpaths(&truth).into_iter().take(20).collect()
+}
+
+/// Every closed subpath of a traced document, over all layers.
+fn traced_subpaths(doc: &flourish::svg_out::Document) -> Vec<kurbo::BezPath> {
+    subpaths(
         &doc.groups
             .iter()
             .flat_map(|g| g.shapes.iter().map(|s| s.path.clone()))
             .collect::<Vec<_>>(),
-    );
+    )
+}
+
+fn hairlines_keep_their_weight_with(input: &InputOptions) {
+    use kurbo::Shape;
+    let png = root().join("samples/trace/thin-lines.png");
+    let lines = thin_lines_drawn();
+    let doc = trace_file(&png, input, &TraceOptions::default()).expect("traces");
+    let traced = traced_subpaths(&doc);
     let mut total = 0.0;
     for line in &lines {
         let bb = line.bounding_box();
@@ -416,21 +427,9 @@ fn binary_hairlines_keep_their_weight() {
     let ink = |x: i64, y: i64| {
         x >= 0 && y >= 0 && x < w && y < h && img.get_pixel(x as u32, y as u32)[0] < 128
     };
-    let svg = std::fs::read_to_string(root().join("samples/trace/thin-lines.svg")).expect("svg");
-    let truth: Vec<kurbo::BezPath> = svg
-        .split(" d=\"")
-        .skip(1)
-        .filter_map(|s| s.split('"').next())
-        .map(|d| kurbo::BezPath::from_svg(d).expect("truth path"))
-        .collect();
-    let lines: Vec<kurbo::BezPath> = subpaths(&truth).into_iter().take(20).collect();
+    let lines = thin_lines_drawn();
     let doc = trace_file(&png, &InputOptions::default(), &TraceOptions::default()).expect("traces");
-    let traced: Vec<kurbo::BezPath> = subpaths(
-        &doc.groups
-            .iter()
-            .flat_map(|g| g.shapes.iter().map(|s| s.path.clone()))
-            .collect::<Vec<_>>(),
-    );
+    let traced = traced_subpaths(&doc);
     let mut total = 0.0;
     for line in &lines {
         let bb = line.bounding_box().inflate(1.0, 1.0);

@@ -687,6 +687,14 @@ mod tests {
         assert!(checked > 5000, "only {checked} vertices");
     }
 
+    /// The one closed path round the ink of a bitmap with one island.
+    fn only_path(cov: &Grid<f32>) -> Vec<Point> {
+        let values = cov.map(|c| if c >= 0.5 { -0.5 } else { 0.5 });
+        let mut cs = contour::extract(&values);
+        assert_eq!(cs.len(), 1);
+        cs.remove(0).points
+    }
+
     /// Along an edge longer than [`MAX_RUN`] vertices (a bar 300 px
     /// long), every run stops at the cap, jumping there in one step, and
     /// agrees with the vertex-by-vertex reference.
@@ -699,10 +707,7 @@ mod tests {
                 0.0
             }
         });
-        let values = cov.map(|c| if c >= 0.5 { -0.5 } else { 0.5 });
-        let cs = contour::extract(&values);
-        assert_eq!(cs.len(), 1);
-        let path = &cs[0].points;
+        let path = &only_path(&cov);
         let runs = Runs::new(path);
         let mut capped = 0;
         for i in 0..path.len() {
@@ -728,10 +733,7 @@ mod tests {
                 0.0
             }
         });
-        let values = cov.map(|c| if c >= 0.5 { -0.5 } else { 0.5 });
-        let cs = contour::extract(&values);
-        assert_eq!(cs.len(), 1);
-        let path = &cs[0].points;
+        let path = &only_path(&cov);
         let n = path.len();
         let lon = straight_runs(path);
         for (i, &m) in lon.iter().enumerate() {
