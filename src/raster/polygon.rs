@@ -79,9 +79,9 @@ pub(super) fn straight_runs(path: &[Point]) -> Vec<usize> {
 /// Loops with at least this many vertices compute their runs in parallel.
 const PARALLEL_RUNS: usize = 4096;
 
-/// What the straight-run walk needs of a path, computed once: its steps and
-/// how far each step repeats. [`Runs::from`] is then one vertex's run, so
-/// the polygon search (step 3) computes runs only at the vertices it visits.
+/// What the straight-run walk needs of a path, computed once: its steps'
+/// directions and how far each step repeats. [`Runs::from`] is then one
+/// vertex's run.
 pub(super) struct Runs<'a> {
     path: &'a [Point],
     /// The direction (of eight, [`direction`]) of the step into each vertex.

@@ -232,9 +232,10 @@ pub(super) fn fit_span_direct(
     // points that pass, which a curve crossing a corner of the outline or
     // of the corridor uses (a one-handle cubic on the binary glyph 'a'
     // strayed 0.48 px between points 0.4 px apart). A midpoint within the
-    // slack its neighbour left costs no search (`Piece::holds`).
+    // slack its neighbour left costs no search (`Piece::holds`). The
+    // coarse points passed already and are not checked again.
     let m = pts.m;
-    let fine = (1..2 * m).map(|j| {
+    let fine = (1..2 * m).filter(|j| j % 16 != 0).map(|j| {
         if j % 2 == 0 {
             pts.pts.get(j / 2).copied().unwrap_or(c.p3)
         } else {
