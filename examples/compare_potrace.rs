@@ -1,6 +1,7 @@
 //! Prints a markdown table comparing `flourish trace` (default options) with
-//! potrace (`potrace -s`, default options, on the 50 %-thresholded bitmap)
-//! on every sample in `samples/trace`: segments, max deviation from the
+//! potrace (`potrace -s`, default options but for the speck size, set to
+//! drop what flourish drops: `-t 3` against `--min-area 4`; on the 50
+//! %-thresholded bitmap) on every sample in `samples/trace`: segments, max deviation from the
 //! vector ground truth (symmetric Hausdorff, px) and median time of 5 runs.
 //!
 //! ```text
@@ -43,7 +44,7 @@ fn main() {
         .filter(|n| n.ends_with(".png"))
         .collect();
     names.sort();
-    println!("Median of {runs} runs; deviations are symmetric Hausdorff distances (px) to the SVG ground truth; IoU: rendered output vs 50 %-thresholded input.\n");
+    println!("Median of {runs} runs; potrace -t {}; deviations are symmetric Hausdorff distances (px) to the SVG ground truth; IoU: rendered output vs 50 %-thresholded input.\n", support::potrace_turdsize());
     println!("| file | size | flourish segments | potrace segments | segment ratio | flourish max dev | potrace max dev | flourish median ms | potrace median ms | time ratio | flourish IoU | potrace IoU |");
     println!("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     let (mut fs, mut ps) = (0usize, 0usize);

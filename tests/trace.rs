@@ -502,3 +502,50 @@ fn binary_hairlines_keep_their_weight() {
     eprintln!("mean weight error {mean:.4}");
     assert!(mean <= 0.03, "mean weight error {mean:.3}");
 }
+
+/// `--min-area` counts a binary bitmap's pixels, as potrace's speck size
+/// does: a 2 × 2 dot and a 2 × 2 pinhole are 4 px² and stay at the default
+/// (their smoothed curves enclose only about 3 px², which dropped them
+/// before), a 3-pixel speck goes, and `--min-area 3` keeps it.
+#[test]
+fn specks_are_measured_in_pixels() {
+    use flourish::raster::{binary, Grid};
+    use flourish::trace::trace_outline;
+    // A 2 × 2 dot, a 3-pixel L and an 8 × 8 square with a 2 × 2 hole.
+    let ink = |x: usize, y: usize| {
+        let dot = (2..4).contains(&x) && (2..4).contains(&y);
+        let l = (x, y) == (8, 2) || (x, y) == (8, 3) || (x, y) == (9, 3);
+        let square = (2..10).contains(&x) && (8..16).contains(&y);
+        let hole = (5..7).contains(&x) && (11..13).contains(&y);
+        dot || l || (square && !hole)
+    };
+    let cov = Grid::from_fn(14, 20, |x, y| if ink(x, y) { 1.0f32 } else { 0.0 });
+    let loops = binary::smooth_loops(&cov);
+    let areas: Vec<f64> = loops.iter().map(|l| l.area).collect();
+    assert_eq!(
+        areas,
+        vec![4.0, 3.0, 64.0, -4.0],
+        "pixel areas of the loops"
+    );
+    let traced = |min_area: f64| -> Vec<usize> {
+        trace_outline(
+            &loops,
+            None,
+            &TraceOptions {
+                min_area,
+                ..TraceOptions::default()
+            },
+        )
+        .iter()
+        .map(|p| subpaths(std::slice::from_ref(p)).len())
+        .collect()
+    };
+    // Islands, each with its subpaths (outer, then holes).
+    assert_eq!(
+        traced(4.0),
+        vec![1, 2],
+        "default: the dot and the holed square"
+    );
+    assert_eq!(traced(3.0), vec![1, 1, 2], "the L kept too");
+    assert_eq!(traced(5.0), vec![1], "the square alone, hole filled");
+}

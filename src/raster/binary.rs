@@ -90,6 +90,12 @@ pub struct SmoothLoop {
     pub tangents: Vec<Vec2>,
     /// Indices into `points` of the corners, ascending.
     pub corners: Vec<usize>,
+    /// The signed area (px²) of what the loop stands for, positive for
+    /// outer loops: for a bitmap's loop the pixels its path bounds
+    /// ([`paths::pixel_area`], so a 2 × 2 dot is 4 px² however its curve
+    /// rounds it), for a [`polygon_loop`] the polygon's own. The speck
+    /// threshold (`--min-area`) reads this.
+    pub area: f64,
 }
 
 /// The smoothed outline of binary coverage `cov` as [`SmoothLoop`]s with
@@ -119,19 +125,23 @@ pub fn smooth_outline(cov: &Coverage) -> Vec<Vec<Point>> {
 /// Steps 2–5 for one closed path.
 fn smooth_loop(path: &[Point]) -> SmoothLoop {
     let n = path.len();
-    if n < 4 {
-        return polyline_loop(path);
-    }
-    let ahead = possible_segments(&straight_runs(path));
-    let poly = optimal_polygon(path, &ahead);
-    if poly.len() < 3 {
-        return polyline_loop(path);
-    }
-    let lines = edge_lines(path, &poly);
-    let vertices = adjust_vertices(path, &poly, &lines);
-    let (vertices, caps) = line_ends::square_line_ends(path, &poly, &lines, vertices);
-    let (vertices, caps) = line_ends::mitre_short_edges(vertices, caps);
-    smooth_polygon(&vertices, &caps)
+    let mut l = if n < 4 {
+        polyline_loop(path)
+    } else {
+        let ahead = possible_segments(&straight_runs(path));
+        let poly = optimal_polygon(path, &ahead);
+        if poly.len() < 3 {
+            polyline_loop(path)
+        } else {
+            let lines = edge_lines(path, &poly);
+            let vertices = adjust_vertices(path, &poly, &lines);
+            let (vertices, caps) = line_ends::square_line_ends(path, &poly, &lines, vertices);
+            let (vertices, caps) = line_ends::mitre_short_edges(vertices, caps);
+            smooth_polygon(&vertices, &caps)
+        }
+    };
+    l.area = paths::pixel_area(path);
+    l
 }
 
 /// A loop too small to smooth, kept as its polygon: every vertex a corner.
@@ -142,6 +152,7 @@ fn polyline_loop(path: &[Point]) -> SmoothLoop {
         points: path.to_vec(),
         tangents,
         corners: (0..n).collect(),
+        area: contour::signed_area(path),
     }
 }
 
@@ -377,10 +388,12 @@ pub fn polygon_loop(points: Vec<Point>) -> SmoothLoop {
     let tangents = (0..n)
         .map(|i| unit(points[(i + 1) % n] - points[i]))
         .collect();
+    let area = contour::signed_area(&points);
     let mut l = SmoothLoop {
         points,
         tangents,
         corners,
+        area,
     };
     smooth_tangents(&mut l);
     l

@@ -212,6 +212,13 @@ const MITRE_REACH: f64 = 4.0;
 /// miter limit), so an acute apex does not overshoot the pixels by more.
 const MITRE_OUT: f64 = 1.5;
 
+/// Narrowest cut (px) across a mitre: a cut end narrower than a pixel is
+/// not something a binary bitmap can show (its edges are uncertain by
+/// half a pixel either way), and as a flat of its own it would cost a
+/// cubic; such a mitre ends in the point in the middle of the cut
+/// instead (on the 2 Mpx ornament, 28 fewer segments).
+const MIN_CUT: f64 = 1.0;
+
 /// [`MITRE_OUT`] for a concave turn (the notch inside a zigzag's apex),
 /// whose tip reaches into the ink: longer, as the notch of a 1-px zigzag
 /// reaches about 2 px past its pixels' edge and stays a sharp V.
@@ -335,7 +342,8 @@ pub(super) fn mitre_short_edges(v: Vec<Point>, keep: Vec<bool>) -> (Vec<Point>, 
 /// The mitre over the short edge `p → q` whose neighbouring edges meet at
 /// `tip`: the tip itself, or, when it reaches more than `limit` px beyond
 /// the edge's middle, the two points where the cut square to the bisector
-/// at that distance crosses the edges' lines.
+/// at that distance crosses the edges' lines (the cut's middle when they
+/// are less than [`MIN_CUT`] apart).
 fn mitre(p: Point, q: Point, tip: Point, limit: f64) -> Vec<Point> {
     let m = p.midpoint(q);
     let out = tip - m;
@@ -353,7 +361,12 @@ fn mitre(p: Point, q: Point, tip: Point, limit: f64) -> Vec<Point> {
         }
         from + (tip - from) * ((limit - (from - m).dot(u)) / rise)
     };
-    vec![cut(p), cut(q)]
+    let (a, b) = (cut(p), cut(q));
+    if (b - a).hypot() < MIN_CUT {
+        // Too narrow to show: the point in the middle of the cut.
+        return vec![a.midpoint(b)];
+    }
+    vec![a, b]
 }
 
 #[cfg(test)]

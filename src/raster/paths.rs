@@ -117,6 +117,42 @@ impl Bitmap {
     }
 }
 
+/// The signed area (px²) of the pixels a closed path bounds: the shoelace
+/// area of the path with each diagonal step's pixel corner put back (the
+/// step cuts that corner's triangle, ⅛ px², off or on). For an island
+/// that is its pixel count, holes included (potrace's path area, which its
+/// speck threshold `turdsize` reads, Selinger 2003 §2.1); a hole's is
+/// minus its paper pixels. Outer paths are positive, as
+/// [`crate::trace::contour::signed_area`] has them.
+pub fn pixel_area(path: &[Point]) -> f64 {
+    let n = path.len();
+    let Some(&o) = path.first() else {
+        return 0.0;
+    };
+    // Relative to the first vertex, so the products stay small (and exact:
+    // every coordinate is a multiple of ½).
+    let cross = |p: Point, q: Point| (p.x - o.x) * (q.y - o.y) - (q.x - o.x) * (p.y - o.y);
+    let mut twice = 0.0;
+    for k in 0..n {
+        let p = path[k];
+        let q = path[(k + 1) % n];
+        let d = q - p;
+        if d.x.abs() == 0.5 && d.y.abs() == 0.5 {
+            // One end is on a vertical pixel edge (whole x), the other on a
+            // horizontal one (whole y): the corner takes the whole x and y.
+            let c = if p.x.fract() == 0.0 {
+                Point::new(p.x, q.y)
+            } else {
+                Point::new(q.x, p.y)
+            };
+            twice += cross(p, c) + cross(c, q);
+        } else {
+            twice += cross(p, q);
+        }
+    }
+    0.5 * twice
+}
+
 /// A link between two 4-adjacent pixel centres (x, y) and (x + 1, y)
 /// (horizontal) or (x, y + 1) (vertical), as in [`crate::trace::contour`].
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -317,6 +353,10 @@ mod tests {
         assert_eq!(ps.len(), 2);
         assert!((contour::signed_area(&ps[0]) - (25.0 - 0.5)).abs() < 1e-12);
         assert!((contour::signed_area(&ps[1]) + 0.5).abs() < 1e-12);
+        // The pixels themselves: 25 in the island, holes included, and the
+        // one-pixel hole.
+        assert_eq!(pixel_area(&ps[0]), 25.0);
+        assert_eq!(pixel_area(&ps[1]), -1.0);
     }
 
     #[test]
@@ -363,6 +403,34 @@ mod tests {
                 ((z >> 11) as f64 / (1u64 << 53) as f64) < density
             });
             prop_assert_eq!(paths(&bits), reference(&bits));
+        }
+
+        /// The pixel areas of all paths (holes negative) add up to the
+        /// ink's pixel count, saddles and borders included; each island's
+        /// is a whole number of pixels.
+        #[test]
+        fn pixel_areas_count_the_ink(
+            w in 1usize..30,
+            h in 1usize..20,
+            density in 0.05f64..0.95,
+            seed in any::<u64>(),
+        ) {
+            let bits = Bitmap::from_fn(w, h, |x, y| {
+                let mut z = seed ^ (x as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)
+                    ^ (y as u64).wrapping_mul(0xc2b2_ae3d_27d4_eb4f);
+                z ^= z >> 31;
+                z = z.wrapping_mul(0xbf58_476d_1ce4_e5b9);
+                z ^= z >> 29;
+                ((z >> 11) as f64 / (1u64 << 53) as f64) < density
+            });
+            let ink = (0..w * h)
+                .filter(|&i| bits.ink((i % w) as isize, (i / w) as isize))
+                .count();
+            let areas: Vec<f64> = paths(&bits).iter().map(|p| pixel_area(p)).collect();
+            for a in &areas {
+                prop_assert!(a.fract() == 0.0 && *a != 0.0, "{}", a);
+            }
+            prop_assert_eq!(areas.iter().sum::<f64>(), ink as f64);
         }
     }
 }

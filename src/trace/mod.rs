@@ -82,7 +82,8 @@ pub struct Island {
 /// dropped (an island's holes go with it). Order follows the input.
 pub fn nest(contours: Vec<Contour>, min_area: f64) -> Vec<Island> {
     let polys: Vec<&[Point]> = contours.iter().map(|c| c.points.as_slice()).collect();
-    let groups = nest_polygons(&polys, min_area);
+    let areas: Vec<f64> = contours.iter().map(Contour::signed_area).collect();
+    let groups = nest_polygons(&polys, &areas, min_area);
     let mut slots: Vec<Option<Contour>> = contours.into_iter().map(Some).collect();
     groups
         .into_iter()
@@ -94,16 +95,17 @@ pub fn nest(contours: Vec<Contour>, min_area: f64) -> Vec<Island> {
         .collect()
 }
 
-/// [`nest`] on bare closed polygons: `(outer, holes)` as indices into
+/// [`nest`] on bare closed polygons with their signed `areas` (px²,
+/// outer boundaries positive; what the speck threshold `min_area` reads,
+/// which need not be the polygon's own): `(outer, holes)` as indices into
 /// `polys`, outers in input order.
-pub fn nest_polygons(polys: &[&[Point]], min_area: f64) -> Vec<(usize, Vec<usize>)> {
+pub fn nest_polygons(polys: &[&[Point]], areas: &[f64], min_area: f64) -> Vec<(usize, Vec<usize>)> {
     let mut outers = Vec::new();
     let mut holes = Vec::new();
-    for (i, pts) in polys.iter().enumerate() {
+    for (i, (pts, &a)) in polys.iter().zip(areas).enumerate() {
         if pts.is_empty() {
             continue;
         }
-        let a = contour::signed_area(pts);
         if a.abs() < min_area {
             continue;
         }
@@ -172,6 +174,7 @@ pub fn trace_outline(
     opts: &TraceOptions,
 ) -> Vec<BezPath> {
     let polys: Vec<&[Point]> = loops.iter().map(|l| l.points.as_slice()).collect();
+    let areas: Vec<f64> = loops.iter().map(|l| l.area).collect();
     // Every loop is fitted on its own (in parallel: one island can hold
     // most of the work) while the loops are nested, then the islands are
     // assembled in order, so the output does not depend on the thread
@@ -179,14 +182,13 @@ pub fn trace_outline(
     // drops them by the same measure); the rare hole nesting finds no
     // outer for is fitted for nothing.
     let (islands, mut fitted) = rayon::join(
-        || nest_polygons(&polys, opts.min_area),
+        || nest_polygons(&polys, &areas, opts.min_area),
         || {
             loops
                 .par_iter()
                 .map(|l| {
                     let mut path = BezPath::new();
-                    let big = !l.points.is_empty()
-                        && contour::signed_area(&l.points).abs() >= opts.min_area;
+                    let big = !l.points.is_empty() && l.area.abs() >= opts.min_area;
                     if big {
                         cover::fit_outline(
                             &l.points,

@@ -17,7 +17,10 @@
 //!   paths (flattened at 0.01 px) and the truth, both sampled every 0.1 px
 //!   of arc length, nearest distances from a uniform grid of segments.
 //!   Accuracy about ±0.06 px (flattening plus half the sample spacing).
-//! * [`run_potrace`], [`run_flourish`]: the two tracers, timed.
+//! * [`run_potrace`], [`run_flourish`]: the two tracers, timed, with the
+//!   same speck size: potrace's `-t` ([`potrace_turdsize`]) is set so both
+//!   drop the same islands (flourish's `--min-area` counts a binary
+//!   bitmap's pixels, as potrace's speck size does).
 
 #![allow(dead_code)]
 
@@ -502,9 +505,21 @@ fn svg_paths(tree: &usvg::Tree, scale: (f64, f64)) -> Vec<BezPath> {
     out
 }
 
+/// potrace's speck size (`-t N`: islands of up to N pixels are dropped)
+/// that drops what flourish's [`flourish_options`] drop (islands of fewer
+/// than `min_area` pixels): `⌈min_area⌉ − 1`, 3 at flourish's default
+/// (potrace's own default is 2). `POTRACE_TURDSIZE` overrides it.
+pub fn potrace_turdsize() -> u32 {
+    std::env::var("POTRACE_TURDSIZE")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| (flourish_options().min_area.ceil() as u32).saturating_sub(1))
+}
+
 /// Traces `bitmap` (ink where luma < 128) with potrace's defaults
-/// (`potrace -s`): its paths in pixel coordinates, its segment count (lines
-/// and curves) and the median wall-clock time of `runs` runs of the process.
+/// (`potrace -s`) but for the speck size ([`potrace_turdsize`]): its paths
+/// in pixel coordinates, its segment count (lines and curves) and the
+/// median wall-clock time of `runs` runs of the process.
 pub fn run_potrace(bitmap: &image::GrayImage, runs: usize) -> (Vec<BezPath>, usize, Duration) {
     let dir = tempfile::tempdir().expect("temp dir");
     let pbm = dir.path().join("in.pbm");
@@ -516,6 +531,8 @@ pub fn run_potrace(bitmap: &image::GrayImage, runs: usize) -> (Vec<BezPath>, usi
         let t = Instant::now();
         let st = Command::new("potrace")
             .arg("-s")
+            .arg("-t")
+            .arg(potrace_turdsize().to_string())
             .arg("-o")
             .arg(&svg)
             .arg(&pbm)
