@@ -247,12 +247,15 @@ proptest! {
 /// its sub-pixel outline. For a binary bitmap it is the corridor where the
 /// bitmap's edge may lie (`raster::corridor`): within tolerance + 0.05 px
 /// of the smoothed outline, or of the corridor while no further than its
-/// half-width + tolerance + 0.05 px from the smoothed outline.
+/// half-width + tolerance + 0.05 px from the smoothed outline. A binary
+/// bitmap is traced path by path (`trace_bitmap`): the same curves as its
+/// smoothed loops fitted together.
 #[test]
 fn outline_curves_stay_within_tolerance_of_their_reference() {
+    use flourish::raster::binary::bitmap_loops;
     use flourish::raster::corridor::Corridor;
-    use flourish::raster::input::{load_traceable, Traceable};
-    use flourish::trace::trace_outline;
+    use flourish::raster::input::{load_traceable, LayerOutline, Traceable};
+    use flourish::trace::{trace_bitmap, trace_outline};
     let opts = TraceOptions::default();
     let slack = 0.05;
     for name in ["glyph-a-binary.png", "glyph-a.png", "holes.png"] {
@@ -263,9 +266,20 @@ fn outline_curves_stay_within_tolerance_of_their_reference() {
             panic!("{name}: a bitmap is traced from its outline");
         };
         assert_eq!(ink.layers.len(), 1, "{name}: one layer");
-        let o = &ink.layers[0];
-        let segs: Vec<kurbo::Line> = o
-            .loops
+        let (loops, corridor) = match &ink.layers[0].outline {
+            LayerOutline::Bitmap(bits) => {
+                let loops = bitmap_loops(bits);
+                let corridor = Corridor::from_bitmap(bits);
+                assert_eq!(
+                    trace_bitmap(bits, &opts),
+                    trace_outline(&loops, Some(&corridor), &opts),
+                    "{name}: path by path as all at once"
+                );
+                (loops, Some(corridor))
+            }
+            LayerOutline::Loops(loops) => (loops.clone(), None),
+        };
+        let segs: Vec<kurbo::Line> = loops
             .iter()
             .flat_map(|l| {
                 let n = l.points.len();
@@ -283,7 +297,7 @@ fn outline_curves_stay_within_tolerance_of_their_reference() {
         };
         let mut count = 0usize;
         let mut loose = 0usize;
-        for p in trace_outline(&o.loops, o.corridor.as_ref(), &opts) {
+        for p in trace_outline(&loops, corridor.as_ref(), &opts) {
             for seg in p.segments() {
                 count += 1;
                 for k in 0..=32 {
@@ -292,7 +306,7 @@ fn outline_curves_stay_within_tolerance_of_their_reference() {
                     if d <= opts.tolerance + slack {
                         continue;
                     }
-                    let c: Option<&Corridor> = o.corridor.as_ref();
+                    let c: Option<&Corridor> = corridor.as_ref();
                     let ok = c.is_some_and(|c| {
                         c.reaches(q, opts.tolerance + slack)
                             && d <= Corridor::HALF_WIDTH + opts.tolerance + slack
@@ -307,7 +321,7 @@ fn outline_curves_stay_within_tolerance_of_their_reference() {
         }
         assert!(count > 0, "{name}: nothing traced");
         eprintln!("{name}: {count} segments, {loose} samples use the corridor");
-        if o.corridor.is_none() {
+        if corridor.is_none() {
             assert_eq!(loose, 0);
         }
     }

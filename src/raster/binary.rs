@@ -122,8 +122,10 @@ pub fn smooth_outline(cov: &Coverage) -> Vec<Vec<Point>> {
     smooth_loops(cov).into_iter().map(|l| l.points).collect()
 }
 
-/// Steps 2–5 for one closed path.
-fn smooth_loop(path: &[Point]) -> SmoothLoop {
+/// Steps 2–6 for one closed path of a bitmap's ink (pixel coordinates, as
+/// [`paths::paths`] gives them): its smoothed loop. A loop of fewer than
+/// three points is too small to keep.
+pub fn smooth_loop(path: &[Point]) -> SmoothLoop {
     let n = path.len();
     let mut l = if n < 4 {
         polyline_loop(path)

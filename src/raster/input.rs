@@ -115,45 +115,41 @@ pub struct OutlineInk {
 pub struct OutlineLayer {
     /// The ink's colour.
     pub color: Color,
-    /// The outline's closed loops, in pixel coordinates.
-    pub loops: Vec<super::binary::SmoothLoop>,
-    /// For a binary layer, where its edge may lie: curves fitted to the
-    /// loops may use this band instead of hugging them. None for an
-    /// anti-aliased layer, whose outline is known to a fraction of a pixel.
-    pub corridor: Option<super::corridor::Corridor>,
+    /// What the layer's outline is read from.
+    pub outline: LayerOutline,
+}
+
+/// What an [`OutlineLayer`]'s outline is read from.
+#[derive(Clone, Debug)]
+pub enum LayerOutline {
+    /// A binary layer's ink. Its paths are smoothed
+    /// ([`super::binary::smooth_loop`]) and fitted one at a time, in
+    /// parallel, by [`crate::trace::trace_bitmap`], with the corridor
+    /// where its edge may lie ([`super::corridor`]); the smoothed loops
+    /// are never all held at once.
+    Bitmap(super::paths::Bitmap),
+    /// An anti-aliased layer's sub-pixel outline, known to a fraction of a
+    /// pixel, as closed loops in pixel coordinates.
+    Loops(Vec<super::binary::SmoothLoop>),
 }
 
 impl OutlineLayer {
-    /// The layer of a binary bitmap's ink: its smooth outline, with the
-    /// corridor built alongside.
-    fn binary(color: Color, bits: &super::paths::Bitmap) -> OutlineLayer {
-        let (loops, corridor) = rayon::join(
-            || super::binary::bitmap_loops(bits),
-            || super::corridor::Corridor::from_bitmap(bits),
-        );
-        OutlineLayer {
-            color,
-            loops,
-            corridor: Some(corridor),
-        }
-    }
-
     /// The layer of fractional coverage `cov`: its sub-pixel outline, or
-    /// the smooth outline when every value is 0 or 1 (a binary layer of a
-    /// colour raster).
+    /// its ink when every value is 0 or 1 (a binary layer of a colour
+    /// raster).
     fn coverage(color: Color, cov: &super::Coverage) -> OutlineLayer {
-        if super::binary::is_binary(cov) {
-            return Self::binary(color, &super::paths::Bitmap::from_coverage(cov));
-        }
-        OutlineLayer {
-            color,
-            loops: super::sdf::subpixel_outline(cov)
-                .into_par_iter()
-                .filter(|p| p.len() >= 3)
-                .map(super::binary::polygon_loop)
-                .collect(),
-            corridor: None,
-        }
+        let outline = if super::binary::is_binary(cov) {
+            LayerOutline::Bitmap(super::paths::Bitmap::from_coverage(cov))
+        } else {
+            LayerOutline::Loops(
+                super::sdf::subpixel_outline(cov)
+                    .into_par_iter()
+                    .filter(|p| p.len() >= 3)
+                    .map(super::binary::polygon_loop)
+                    .collect(),
+            )
+        };
+        OutlineLayer { color, outline }
     }
 }
 
@@ -165,9 +161,14 @@ pub fn load_traceable(path: &Path, opts: &InputOptions) -> Result<Traceable> {
         return load_svg(path, &bytes, opts).map(Traceable::Field);
     }
     let (w, h, layers) = match raster_coverage(path, &bytes, opts)? {
-        RasterCoverage::Binary { w, h, color, bits } => {
-            (w, h, vec![OutlineLayer::binary(color, &bits)])
-        }
+        RasterCoverage::Binary { w, h, color, bits } => (
+            w,
+            h,
+            vec![OutlineLayer {
+                color,
+                outline: LayerOutline::Bitmap(bits),
+            }],
+        ),
         RasterCoverage::Layers { w, h, layers } => (
             w,
             h,

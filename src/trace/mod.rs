@@ -20,9 +20,10 @@ mod sample;
 mod span;
 
 use crate::error::{Error, Result};
-use crate::raster::binary::SmoothLoop;
+use crate::raster::binary::{self, SmoothLoop};
 use crate::raster::corridor::Corridor;
-use crate::raster::input::{self, Ink, InputOptions, Traceable};
+use crate::raster::input::{self, Ink, InputOptions, LayerOutline, Traceable};
+use crate::raster::paths::{self, Bitmap};
 use crate::raster::Sdf;
 use crate::svg_out::{decimals_for, Color, Document, FillRule, Group, Shape};
 use contour::{contains, Contour};
@@ -113,20 +114,30 @@ pub fn nest_polygons(polys: &[&[Point]], areas: &[f64], min_area: f64) -> Vec<(u
         if a > 0.0 {
             outers.push((i, bbox, a));
         } else {
-            holes.push((i, bbox));
+            holes.push((i, bbox, -a));
         }
     }
     let mut islands: Vec<(usize, Vec<usize>)> =
         outers.iter().map(|&(i, _, _)| (i, Vec::new())).collect();
-    for (h, hb) in holes {
+    // A hole goes to the smallest outer containing it (the first in input
+    // order among equals): outers are tried by ascending area, from the
+    // first at least as large as the hole, and the first that contains
+    // it wins, so the large outlines (most of the vertices) are only
+    // tested for holes that no smaller island holds.
+    let mut by_area: Vec<usize> = (0..outers.len()).collect();
+    by_area.sort_by(|&a, &b| outers[a].2.total_cmp(&outers[b].2));
+    for (h, hb, ha) in holes {
         let probe = polys[h][0];
-        let owner = outers
+        let from = by_area.partition_point(|&k| outers[k].2 < ha);
+        let owner = by_area
+            .get(from..)
+            .unwrap_or(&[])
             .iter()
-            .enumerate()
-            .filter(|(_, (_, ob, _))| ob.contains(probe) && ob.union(hb) == *ob)
-            .filter(|(_, (o, _, _))| contains(polys[*o], probe))
-            .min_by(|a, b| a.1 .2.total_cmp(&b.1 .2))
-            .map(|(k, _)| k);
+            .copied()
+            .find(|&k| {
+                let (o, ob, _) = outers[k];
+                ob.contains(probe) && ob.union(hb) == ob && contains(polys[o], probe)
+            });
         if let Some(k) = owner {
             islands[k].1.push(h);
         }
@@ -204,16 +215,66 @@ pub fn trace_outline(
                 .collect::<Vec<BezPath>>()
         },
     );
+    assemble(&islands, &mut fitted)
+}
+
+/// Traces a binary bitmap's ink: what [`trace_outline`] makes of its
+/// smoothed loops ([`crate::raster::binary::bitmap_loops`]) and its
+/// [`Corridor`], path by path. Each path is smoothed and fitted in one
+/// task (one parallel pass with no barrier between the two stages, and
+/// no loop kept once fitted), and islands are nested on the pixel paths
+/// themselves, whose containment is the smoothed loops' (the loops stay
+/// within half a pixel of their paths, which lie a pixel apart or more).
+pub fn trace_bitmap(bits: &Bitmap, opts: &TraceOptions) -> Vec<BezPath> {
+    let (paths, corridor) = rayon::join(|| paths::paths(bits), || Corridor::from_bitmap(bits));
+    let polys: Vec<&[Point]> = paths.iter().map(Vec::as_slice).collect();
+    let areas: Vec<f64> = paths.iter().map(|p| paths::pixel_area(p)).collect();
+    let (islands, mut fitted) = rayon::join(
+        || nest_polygons(&polys, &areas, opts.min_area),
+        || {
+            paths
+                .par_iter()
+                .zip(&areas)
+                .map(|(p, &area)| {
+                    let mut path = BezPath::new();
+                    if area.abs() >= opts.min_area {
+                        let l = binary::smooth_loop(p);
+                        if l.points.len() >= 3 {
+                            cover::fit_outline(
+                                &l.points,
+                                &l.tangents,
+                                &l.corners,
+                                opts.tolerance,
+                                Some(&corridor),
+                                &mut path,
+                            );
+                        }
+                    }
+                    path
+                })
+                .collect::<Vec<BezPath>>()
+        },
+    );
+    assemble(&islands, &mut fitted)
+}
+
+/// Each island's fitted loops (`fitted`, by loop index; taken) as one
+/// path, outer boundary first, in the islands' order; an island whose
+/// outer loop was too small to fit is left out.
+fn assemble(islands: &[(usize, Vec<usize>)], fitted: &mut [BezPath]) -> Vec<BezPath> {
     islands
         .iter()
-        .map(|(outer, holes)| {
-            let mut path = BezPath::new();
-            for &i in std::iter::once(outer).chain(holes) {
+        .filter_map(|(outer, holes)| {
+            let mut path = std::mem::take(fitted.get_mut(*outer)?);
+            if path.elements().is_empty() {
+                return None;
+            }
+            for &i in holes {
                 if let Some(p) = fitted.get_mut(i) {
                     path.extend(std::mem::take(p));
                 }
             }
-            path
+            Some(path)
         })
         .collect()
 }
@@ -264,11 +325,11 @@ pub fn trace_file(path: &Path, input: &InputOptions, opts: &TraceOptions) -> Res
         Traceable::Outline(o) => {
             let mut doc = Document::new(o.width, o.height, decimals_for(opts.tolerance));
             for (i, layer) in o.layers.iter().enumerate() {
-                doc.groups.extend(layer_group(
-                    i,
-                    trace_outline(&layer.loops, layer.corridor.as_ref(), opts),
-                    layer.color,
-                ));
+                let paths = match &layer.outline {
+                    LayerOutline::Bitmap(bits) => trace_bitmap(bits, opts),
+                    LayerOutline::Loops(loops) => trace_outline(loops, None, opts),
+                };
+                doc.groups.extend(layer_group(i, paths, layer.color));
             }
             Ok(doc)
         }
