@@ -203,7 +203,10 @@ pub(super) fn fit_span_direct(
     // The best candidate: the smallest outline-to-curve error, scaled up
     // for long handles; a candidate is only measured while it can still
     // beat the best so far.
-    let mut best: Option<(f64, CubicBez, CurvePoints)> = None;
+    // Two flattenings, the best so far's and the one being measured,
+    // swapped in place (a flattening is 1.5 kB: moved, it was copied).
+    let mut flat = [CurvePoints::empty(), CurvePoints::empty()];
+    let mut best: Option<(f64, CubicBez, usize)> = None;
     for &(d0, d1) in &cands[..k] {
         let c = CubicBez::new(
             p0,
@@ -214,14 +217,16 @@ pub(super) fn fit_span_direct(
         let scale = |d: f64| 1.0 + (d - HANDLE_ELBOW).max(0.0) * HANDLE_SLOPE;
         let scale = scale(d0).max(scale(d1));
         let bound = best.as_ref().map_or(reach, |b| b.0.min(reach));
-        let pts = CurvePoints::new(&c);
-        if let Some(err) = outline_to_curve(&pts, samples, bound / scale) {
+        let slot = best.as_ref().map_or(0, |b| 1 - b.2);
+        flat[slot].set(&c);
+        if let Some(err) = outline_to_curve(&flat[slot], samples, bound / scale) {
             if best.as_ref().is_none_or(|b| err * scale < b.0) {
-                best = Some((err * scale, c, pts));
+                best = Some((err * scale, c, slot));
             }
         }
     }
-    let (_, c, pts) = best?;
+    let (_, c, slot) = best?;
+    let pts = &flat[slot];
     let len = piece.length() * (range.end - range.start);
     let (s0, s1) = (range.start * piece.length(), range.end * piece.length());
     // Coarse first: most misfits fail at one of every eighth point.
@@ -269,18 +274,28 @@ pub(super) fn check_chords(length: f64) -> usize {
 }
 
 impl CurvePoints {
-    fn new(c: &CubicBez) -> Self {
+    /// No flattening yet (one chord at the origin).
+    fn empty() -> Self {
+        CurvePoints {
+            pts: [Point::ORIGIN; CURVE_POINTS + 1],
+            cum: [0.0; CURVE_POINTS + 1],
+            m: 1,
+        }
+    }
+
+    /// Flattens `c` in place.
+    fn set(&mut self, c: &CubicBez) {
         let polygon = (c.p1 - c.p0).hypot() + (c.p2 - c.p1).hypot() + (c.p3 - c.p2).hypot();
         let m = check_chords(polygon);
-        let mut pts = [Point::ORIGIN; CURVE_POINTS + 1];
-        let mut cum = [0.0; CURVE_POINTS + 1];
+        let (pts, cum) = (&mut self.pts, &mut self.cum);
+        cum[0] = 0.0;
         for k in 0..=m {
             pts[k] = c.eval(k as f64 / m as f64);
             if k > 0 {
                 cum[k] = cum[k - 1] + (pts[k] - pts[k - 1]).hypot();
             }
         }
-        CurvePoints { pts, cum, m }
+        self.m = m;
     }
 
     /// The flattened points, `m` + 1 of them.
