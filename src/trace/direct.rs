@@ -164,8 +164,7 @@ const HANDLE_ELBOW: f64 = 0.65;
 const HANDLE_SLOPE: f64 = 2.0;
 
 /// Most chords a candidate is flattened into (and points it is checked
-/// at): first every eighth point (a cheap rejection of most misfits), then
-/// the rest.
+/// at, with the midpoints between them).
 const CURVE_POINTS: usize = 64;
 
 /// Fewest chords a candidate is flattened into.
@@ -229,18 +228,17 @@ pub(super) fn fit_span_direct(
     let pts = &flat[slot];
     let len = piece.length() * (range.end - range.start);
     let (s0, s1) = (range.start * piece.length(), range.end * piece.length());
-    // Coarse first: most misfits fail at one of every eighth point.
-    let inner = pts.pts.get(1..pts.m).unwrap_or(&[]);
-    let coarse = inner.iter().skip(7).step_by(8).copied();
-    // Then every point with the midpoints between them, in order: the
+    // Every point with the midpoints between them, in order: the
     // distance to the outline can grow by half the spacing between two
     // points that pass, which a curve crossing a corner of the outline or
     // of the corridor uses (a one-handle cubic on the binary glyph 'a'
     // strayed 0.48 px between points 0.4 px apart). A midpoint within the
-    // slack its neighbour left costs no search (`Piece::holds`). The
-    // coarse points passed already and are not checked again.
+    // slack its neighbour left costs no search (`Piece::holds`). In one
+    // pass: a coarse pass over every eighth point first (each a search of
+    // its own) cost more on the curves that pass, nearly all of those
+    // checked here, than it saved on the few that fail.
     let m = pts.m;
-    let fine = (1..2 * m).filter(|j| j % 16 != 0).map(|j| {
+    let fine = (1..2 * m).map(|j| {
         if j % 2 == 0 {
             pts.pts.get(j / 2).copied().unwrap_or(c.p3)
         } else {
@@ -253,8 +251,7 @@ pub(super) fn fit_span_direct(
     let short = polygon <= 1.5 * len + 0.5
         || pts.cum[pts.m] <= 1.5 * len + 0.5
             && kurbo::ParamCurveArclen::arclen(&c, 0.01) <= 1.5 * len + 0.5;
-    (short && piece.holds(coarse, s0, s1, accuracy) && piece.holds(fine, s0, s1, accuracy))
-        .then_some(c)
+    (short && piece.holds(fine, s0, s1, accuracy)).then_some(c)
 }
 
 /// A cubic flattened at `m` + 1 evenly spaced parameters (`m` chords of
