@@ -164,8 +164,7 @@ const HANDLE_ELBOW: f64 = 0.65;
 const HANDLE_SLOPE: f64 = 2.0;
 
 /// Most chords a candidate is flattened into (and points it is checked
-/// at): first every eighth point (a cheap rejection of most misfits), then
-/// the rest.
+/// at, with the midpoints between them).
 const CURVE_POINTS: usize = 64;
 
 /// Fewest chords a candidate is flattened into.
@@ -203,7 +202,10 @@ pub(super) fn fit_span_direct(
     // The best candidate: the smallest outline-to-curve error, scaled up
     // for long handles; a candidate is only measured while it can still
     // beat the best so far.
-    let mut best: Option<(f64, CubicBez, CurvePoints)> = None;
+    // Two flattenings, the best so far's and the one being measured,
+    // swapped in place (a flattening is 1.5 kB: moved, it was copied).
+    let mut flat = [CurvePoints::empty(), CurvePoints::empty()];
+    let mut best: Option<(f64, CubicBez, usize)> = None;
     for &(d0, d1) in &cands[..k] {
         let c = CubicBez::new(
             p0,
@@ -214,28 +216,29 @@ pub(super) fn fit_span_direct(
         let scale = |d: f64| 1.0 + (d - HANDLE_ELBOW).max(0.0) * HANDLE_SLOPE;
         let scale = scale(d0).max(scale(d1));
         let bound = best.as_ref().map_or(reach, |b| b.0.min(reach));
-        let pts = CurvePoints::new(&c);
-        if let Some(err) = outline_to_curve(&pts, samples, bound / scale) {
+        let slot = best.as_ref().map_or(0, |b| 1 - b.2);
+        flat[slot].set(&c);
+        if let Some(err) = outline_to_curve(&flat[slot], samples, bound / scale) {
             if best.as_ref().is_none_or(|b| err * scale < b.0) {
-                best = Some((err * scale, c, pts));
+                best = Some((err * scale, c, slot));
             }
         }
     }
-    let (_, c, pts) = best?;
+    let (_, c, slot) = best?;
+    let pts = &flat[slot];
     let len = piece.length() * (range.end - range.start);
     let (s0, s1) = (range.start * piece.length(), range.end * piece.length());
-    // Coarse first: most misfits fail at one of every eighth point.
-    let inner = pts.pts.get(1..pts.m).unwrap_or(&[]);
-    let coarse = inner.iter().skip(7).step_by(8).copied();
-    // Then every point with the midpoints between them, in order: the
+    // Every point with the midpoints between them, in order: the
     // distance to the outline can grow by half the spacing between two
     // points that pass, which a curve crossing a corner of the outline or
     // of the corridor uses (a one-handle cubic on the binary glyph 'a'
     // strayed 0.48 px between points 0.4 px apart). A midpoint within the
-    // slack its neighbour left costs no search (`Piece::holds`). The
-    // coarse points passed already and are not checked again.
+    // slack its neighbour left costs no search (`Piece::holds`). In one
+    // pass: a coarse pass over every eighth point first (each a search of
+    // its own) cost more on the curves that pass, nearly all of those
+    // checked here, than it saved on the few that fail.
     let m = pts.m;
-    let fine = (1..2 * m).filter(|j| j % 16 != 0).map(|j| {
+    let fine = (1..2 * m).map(|j| {
         if j % 2 == 0 {
             pts.pts.get(j / 2).copied().unwrap_or(c.p3)
         } else {
@@ -248,8 +251,7 @@ pub(super) fn fit_span_direct(
     let short = polygon <= 1.5 * len + 0.5
         || pts.cum[pts.m] <= 1.5 * len + 0.5
             && kurbo::ParamCurveArclen::arclen(&c, 0.01) <= 1.5 * len + 0.5;
-    (short && piece.holds(coarse, s0, s1, accuracy) && piece.holds(fine, s0, s1, accuracy))
-        .then_some(c)
+    (short && piece.holds(fine, s0, s1, accuracy)).then_some(c)
 }
 
 /// A cubic flattened at `m` + 1 evenly spaced parameters (`m` chords of
@@ -269,18 +271,28 @@ pub(super) fn check_chords(length: f64) -> usize {
 }
 
 impl CurvePoints {
-    fn new(c: &CubicBez) -> Self {
+    /// No flattening yet (one chord at the origin).
+    fn empty() -> Self {
+        CurvePoints {
+            pts: [Point::ORIGIN; CURVE_POINTS + 1],
+            cum: [0.0; CURVE_POINTS + 1],
+            m: 1,
+        }
+    }
+
+    /// Flattens `c` in place.
+    fn set(&mut self, c: &CubicBez) {
         let polygon = (c.p1 - c.p0).hypot() + (c.p2 - c.p1).hypot() + (c.p3 - c.p2).hypot();
         let m = check_chords(polygon);
-        let mut pts = [Point::ORIGIN; CURVE_POINTS + 1];
-        let mut cum = [0.0; CURVE_POINTS + 1];
+        let (pts, cum) = (&mut self.pts, &mut self.cum);
+        cum[0] = 0.0;
         for k in 0..=m {
             pts[k] = c.eval(k as f64 / m as f64);
             if k > 0 {
                 cum[k] = cum[k - 1] + (pts[k] - pts[k - 1]).hypot();
             }
         }
-        CurvePoints { pts, cum, m }
+        self.m = m;
     }
 
     /// The flattened points, `m` + 1 of them.

@@ -16,7 +16,7 @@
 //! the curves meet there at an angle, so sharp corners stay sharp.
 
 use super::corner::corners;
-use super::nearest::{gallop_back_le, gallop_le as gallop, nearest_from};
+use super::nearest::{gallop_back_le, gallop_le as gallop, nearest_segment};
 use super::sample::segment_moments;
 use super::span::{append_loop, line_cubic, longest_span};
 use crate::raster::corridor::Corridor;
@@ -244,14 +244,37 @@ impl<'a> Piece<'a> {
                             return true;
                         }
                     }
-                    let (found, best) =
-                        nearest_from(&self.pts, &self.cum, p, lo, cursor, hi, near, far);
                     anchor = None;
+                    // Ahead of the cursor first (where the curve goes on);
+                    // a point within `far` there that the corridor admits
+                    // passes without the search behind it.
+                    let (found, mut best) =
+                        nearest_segment(&self.pts, &self.cum, p, cursor, hi, near, far);
+                    let mut admitted = None;
+                    let found = match found {
+                        None if cursor > lo => {
+                            if best <= far {
+                                let ok = corridor.is_some_and(|c| c.reaches(p, limit));
+                                if ok {
+                                    return true;
+                                }
+                                admitted = Some(ok);
+                            }
+                            let (j, d) =
+                                nearest_segment(&self.pts, &self.cum, p, lo, cursor - 1, near, far);
+                            best = best.min(d);
+                            j
+                        }
+                        found => found,
+                    };
                     if let Some(j) = found {
                         cursor = j;
                         anchor = Some((p, near - best));
                     }
-                    best <= near || best <= far && corridor.is_some_and(|c| c.reaches(p, limit))
+                    best <= near
+                        || best <= far
+                            && admitted
+                                .unwrap_or_else(|| corridor.is_some_and(|c| c.reaches(p, limit)))
                 })
             }
         }
