@@ -129,14 +129,18 @@ fn flourish_stays_level_with_potrace() {
             c.flourish_segments,
             c.potrace_segments
         );
-        if name == "glyph-a-binary.png" {
-            assert!(
-                c.flourish_dev <= c.potrace_dev,
-                "{name}: symmetric deviation {:.3} px > potrace {:.3}",
-                c.flourish_dev,
-                c.potrace_dev
-            );
-        }
+        // The deviation goal, both ways (symmetric Hausdorff to the
+        // vector truth), at the same speck size: the binary glyph 0.97 vs
+        // 1.15 px, the 2 Mpx ornament 15.0 vs 16.3 (a tendril the bitmap
+        // holds only as dust that both drop), the binary scroll level
+        // (12.08 both, its far point the same dust); within the measure's
+        // accuracy (support: about ±0.06 px).
+        assert!(
+            c.flourish_dev <= c.potrace_dev + 0.05,
+            "{name}: symmetric deviation {:.3} px > potrace {:.3}",
+            c.flourish_dev,
+            c.potrace_dev
+        );
         if name == "ornament-2mp.png" {
             assert!(
                 c.flourish_segments * 5 <= c.potrace_segments * 4,
