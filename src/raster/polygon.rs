@@ -246,22 +246,21 @@ impl Chords {
             .get(start)
             .map_or(Lattice::default(), |&p| Lattice::of(p));
         let (before, after) = path.split_at(start.min(path.len()));
-        let v: Vec<Lattice> = after
-            .iter()
-            .chain(before)
-            .chain(after.first())
-            .map(|&p| Lattice::of(p) - origin)
-            .collect();
+        let mut v = Vec::with_capacity(path.len() + 1);
+        let relative = |&p: &Point| Lattice::of(p) - origin;
+        v.extend(after.iter().map(relative));
+        v.extend(before.iter().map(relative));
+        v.extend(after.first().map(relative));
         let mut s = Vec::with_capacity(v.len() + 1);
         let mut acc = [0i64; 5];
         s.push(acc);
-        for q in &v {
+        s.extend(v.iter().map(|q| {
             let terms = [q.x, q.y, q.x * q.x, q.x * q.y, q.y * q.y];
             for (a, t) in acc.iter_mut().zip(terms) {
                 *a = a.wrapping_add(t);
             }
-            s.push(acc);
-        }
+            acc
+        }));
         Chords { v, s }
     }
 
@@ -329,12 +328,12 @@ pub(super) fn optimal_polygon(path: &[Point], ahead: &[usize]) -> Vec<usize> {
     // nearest vertex a segment into j can start from (relative indices,
     // the start at 0 and again at n). Both are nondecreasing.
     let (before, after) = ahead.split_at(start);
-    let clip0: Vec<usize> = after
-        .iter()
-        .chain(before)
-        .enumerate()
-        .map(|(i, &a)| (i + a.max(1)).min(n))
-        .collect();
+    let mut clip0 = Vec::with_capacity(n);
+    clip0.extend(after.iter().map(|&a| a.max(1)));
+    clip0.extend(before.iter().map(|&a| a.max(1)));
+    for (i, c) in clip0.iter_mut().enumerate() {
+        *c = (*c + i).min(n);
+    }
     let mut clip1 = vec![0usize; n + 1];
     let mut i = 0;
     for (j, c) in clip1.iter_mut().enumerate().skip(1) {

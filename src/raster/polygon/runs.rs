@@ -80,21 +80,21 @@ impl Runs {
     pub(super) fn new(path: &[Point]) -> Self {
         let path: Vec<Lattice> = path.iter().map(|&p| Lattice::of(p)).collect();
         let n = path.len();
-        let mut after: Vec<Step> = path
-            .iter()
-            .zip(path.iter().skip(1).chain(path.first()))
-            .map(|(&a, &b)| {
-                let s = b - a;
-                let bit = 1u8 << s.direction();
-                Step {
-                    x: s.x as i32,
-                    y: s.y as i32,
-                    bit,
-                    near: bit | bit.rotate_left(1) | bit.rotate_right(1),
-                    len: 1,
-                }
-            })
-            .collect();
+        let step = |a: Lattice, b: Lattice| {
+            let s = b - a;
+            let bit = 1u8 << s.direction();
+            Step {
+                x: s.x as i32,
+                y: s.y as i32,
+                bit,
+                near: bit | bit.rotate_left(1) | bit.rotate_right(1),
+                len: 1,
+            }
+        };
+        let mut after: Vec<Step> = path.windows(2).map(|w| step(w[0], w[1])).collect();
+        if let (Some(&last), Some(&first)) = (path.last(), path.first()) {
+            after.push(step(last, first));
+        }
         let same = |a: &Step, b: &Step| (a.x, a.y) == (b.x, b.y);
         // From a vertex whose step differs from the next one's (its
         // stretch is 1) backwards once round the loop: a stretch is one
@@ -103,12 +103,14 @@ impl Runs {
         let next = |k: usize| if k + 1 == n { 0 } else { k + 1 };
         match (0..n).find(|&b| !same(&after[b], &after[next(b)])) {
             Some(b) => {
-                for k in (0..b).rev().chain((b + 1..n).rev()) {
+                let mut extend = |k: usize| {
                     let following = after[next(k)];
                     if same(&after[k], &following) {
                         after[k].len = (following.len + 1).min(cap);
                     }
-                }
+                };
+                (0..b).rev().for_each(&mut extend);
+                (b + 1..n).rev().for_each(&mut extend);
             }
             None => after.iter_mut().for_each(|s| s.len = cap),
         }
