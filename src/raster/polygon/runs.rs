@@ -135,21 +135,26 @@ impl Runs {
         // no vertex is nearer the anchor than one before it (in either
         // coordinate): a notch's back step ends the run.
         let mut allowed = u8::MAX;
-        let (mut j, mut m) = (i, 0usize);
-        // The vertex reached, relative to the anchor.
+        // The vertex reached (j), relative to the anchor, and how many
+        // more vertices the run may take.
+        let mut j = i;
         let mut d = Lattice::default();
+        let Some(mut rem) = limit.checked_sub(1) else {
+            return 1;
+        };
+        let run = |rem: usize| (limit - 1 - rem).max(1);
         // Until the run leaves the box round the anchor, every direction
         // passes through the boxes so far: whole stretches are taken.
         let (mut r, mut l) = loop {
             let Some(&s) = after.get(j) else {
                 return 1;
             };
-            if m + 1 >= limit || allowed & s.bit == 0 {
-                return m.max(1);
+            if rem == 0 || allowed & s.bit == 0 {
+                return run(rem);
             }
             allowed &= s.near;
-            let t = usize::from(s.len).min(limit - 1 - m);
-            m += t;
+            let t = usize::from(s.len).min(rem);
+            rem -= t;
             j = wrap(j + t);
             d = d + Lattice::from(s) * t as i64;
             if d.x.abs() > TOL || d.y.abs() > TOL {
@@ -159,7 +164,7 @@ impl Runs {
         // Then the cone of admissible directions, from its right edge r to
         // its left edge l (counter-clockwise), is narrowed stretch by
         // stretch.
-        while m + 1 < limit {
+        while rem > 0 {
             let Some(&s) = after.get(j) else {
                 break;
             };
@@ -167,20 +172,17 @@ impl Runs {
                 break;
             }
             allowed &= s.near;
-            let reach = usize::from(s.len).min(limit - 1 - m);
+            let reach = usize::from(s.len).min(rem);
             let step = Lattice::from(s);
             let end = d + step * reach as i64;
-            let t = if r.cross(end) >= 0 && end.cross(l) >= 0 {
-                reach
-            } else {
-                admitted(d, step, (r, l), reach)
-            };
-            if t == 0 {
+            if !(r.cross(end) >= 0 && end.cross(l) >= 0) {
+                // The run ends inside this stretch.
+                rem -= admitted(d, step, (r, l), reach);
                 break;
             }
-            m += t;
-            j = wrap(j + t);
-            d = d + step * t as i64;
+            rem -= reach;
+            j = wrap(j + reach);
+            d = end;
             // The box round d narrows the cone; nothing is left beyond when
             // its edges cross.
             let (right, left) = corners(d);
@@ -190,11 +192,11 @@ impl Runs {
             if left.cross(l) > 0 {
                 l = left;
             }
-            if t < reach || r.cross(l) < 0 {
+            if r.cross(l) < 0 {
                 break;
             }
         }
-        m.max(1)
+        run(rem)
     }
 }
 
