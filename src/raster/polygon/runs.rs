@@ -91,7 +91,8 @@ impl Runs {
                 len: 1,
             }
         };
-        let mut after: Vec<Step> = path.windows(2).map(|w| step(w[0], w[1])).collect();
+        let mut after: Vec<Step> = Vec::with_capacity(n);
+        after.extend(path.windows(2).map(|w| step(w[0], w[1])));
         if let (Some(&last), Some(&first)) = (path.last(), path.first()) {
             after.push(step(last, first));
         }
