@@ -24,11 +24,13 @@ use super::{Lattice, MAX_RUN};
 use kurbo::Point;
 use rayon::prelude::*;
 
-#[cfg(doc)]
 use crate::raster::binary::STRAIGHT_TOLERANCE;
 
-/// [`STRAIGHT_TOLERANCE`] (½ px) in doubled pixel coordinates.
-const TOL: i64 = 1;
+/// [`STRAIGHT_TOLERANCE`] in doubled pixel coordinates: the boxes' corners
+/// are lattice points only while it is a multiple of ½ px (checked when
+/// compiling).
+const TOL: i64 = (2.0 * STRAIGHT_TOLERANCE) as i64;
+const _: () = assert!(TOL as f64 == 2.0 * STRAIGHT_TOLERANCE && TOL > 0);
 
 /// Step 2: `lon[i]` = how many vertices ahead of `i` a straight run from `i`
 /// reaches (at least 1, fewer than [`MAX_RUN`]).
@@ -281,7 +283,6 @@ const fn corner_offsets() -> [[i8; 4]; 9] {
 mod tests {
     use super::super::reference::{direction, run_from};
     use super::*;
-    use crate::raster::binary::STRAIGHT_TOLERANCE;
     use crate::raster::Grid;
     use crate::trace::contour;
 
