@@ -365,7 +365,18 @@ pub(super) fn optimal_polygon(path: &[Point], ahead: &[usize]) -> Vec<usize> {
     let mut pen = vec![f64::INFINITY; n + 1];
     let mut prev = vec![0usize; n + 1];
     pen[0] = 0.0;
+    // least[k]: the least total of layer j − 1 from seg1[j − 1] up to k,
+    // so the search into a vertex stops where no start below can win.
+    let mut least = vec![f64::INFINITY; n + 1];
     for j in 1..=m {
+        let range = seg1[j - 1]..=seg0[j - 1].min(n);
+        if let (Some(totals), Some(lows)) = (pen.get(range.clone()), least.get_mut(range)) {
+            let mut low = f64::INFINITY;
+            for (l, &t) in lows.iter_mut().zip(totals) {
+                low = low.min(t);
+                *l = low;
+            }
+        }
         let first = seg1[j];
         let layer = clip1.get(first..=seg0[j].min(n)).unwrap_or_default();
         for (i, &clip) in (first..).zip(layer) {
@@ -374,10 +385,13 @@ pub(super) fn optimal_polygon(path: &[Point], ahead: &[usize]) -> Vec<usize> {
             // (Empty for i = 0, where potrace's loop only compares
             // pen[0] with itself.)
             let (before, rest) = pen.split_at_mut(i);
-            if let (Some(pens), Some(best), Some(p)) =
-                (before.get(lo..=hi), rest.first_mut(), prev.get_mut(i))
-            {
-                (*best, *p) = best_start(&chords, pens, lo, i, (*best, *p));
+            if let (Some(pens), Some(least), Some(best), Some(p)) = (
+                before.get(lo..=hi),
+                least.get(lo..=hi),
+                rest.first_mut(),
+                prev.get_mut(i),
+            ) {
+                (*best, *p) = best_start(&chords, (pens, least), lo, i, (*best, *p));
             }
         }
     }
@@ -399,11 +413,12 @@ pub(super) fn optimal_polygon(path: &[Point], ahead: &[usize]) -> Vec<usize> {
 /// Walking down, the moments about `v_i` grow by one vertex per candidate
 /// (the first read off the prefix sums). `P(k, i) ≥ 0`, so a candidate
 /// whose own total is no better than the best so far cannot win and its
-/// penalty is not evaluated.
+/// penalty is not evaluated; the walk stops where `least` (each
+/// candidate's lower bound on the totals from it down) reaches the best.
 #[inline(never)] // (once per path; kept whole in profiles)
 fn best_start(
     chords: &Chords,
-    pens: &[f64],
+    (pens, least): (&[f64], &[f64]),
     lo: usize,
     i: usize,
     mut best: (f64, usize),
@@ -425,7 +440,11 @@ fn best_start(
     let [mut mxx, mut mxy, mut myy] = moments(a, b, r, c as i64);
     let mut cnt = c as f64;
     let mut k = hi;
-    for (&v, &pk) in vs.iter().zip(pens).rev() {
+    for ((&v, &pk), &low) in vs.iter().zip(pens).zip(least).rev() {
+        if low >= best.0 {
+            // No start from here down has a total below the best.
+            break;
+        }
         let u = v - r;
         let (xx, xy, yy) = (u.x * u.x, u.x * u.y, u.y * u.y);
         if k < hi {
