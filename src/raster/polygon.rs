@@ -1,16 +1,17 @@
 //! Steps 2–3 of [`crate::raster::binary`]: the straight runs of a closed
 //! path and the optimal polygon over them (Selinger 2003, §2.2).
 //!
-//! **Straight runs** (§2.2.1). potrace calls a path straight when a line
-//! passes within an L∞ box of half-side ½ round every vertex and the path
-//! does not step in all four directions. Its implementation anchors the
-//! line at the run's first vertex and narrows a cone of admissible
-//! directions by the box round each later vertex; so does [`Runs`], with
-//! boxes of half-side [`STRAIGHT_TOLERANCE`] round the vertices of
-//! flourish's paths (through pixel-edge midpoints, so they step
-//! diagonally too). The direction rule becomes: a run's steps keep to two
-//! neighbouring directions of the eight (a staircase), so a run never
-//! turns round the end of a line.
+//! **Straight runs** (§2.2.1, the submodule `runs`). potrace calls a path
+//! straight when a line passes within an L∞ box of half-side ½ round every
+//! vertex and the path does not step in all four directions. Its
+//! implementation anchors the line at the run's first vertex and narrows a
+//! cone of admissible directions by the box round each later vertex; so
+//! does flourish, with boxes of half-side [`STRAIGHT_TOLERANCE`] round the
+//! vertices of its paths (through pixel-edge midpoints, so they step
+//! diagonally too), walking from stretch to stretch of repeated steps. The
+//! direction rule becomes: a run's steps keep to two neighbouring
+//! directions of the eight (a staircase), so a run never turns round the
+//! end of a line.
 //!
 //! **Possible segments.** Reaches are made monotone as potrace's `calc_lon`
 //! cleans them up: `i → j` is a possible edge when every vertex from `i`
@@ -20,306 +21,127 @@
 //! **Optimal polygon** (§2.2.2). The fewest possible segments round the
 //! loop, and of those the one with the least sum of penalties: potrace's
 //! `P(i, j) = |p_j − p_i| · √(mean squared distance of p_i … p_j to the
-//! chord)`, read off prefix sums in constant time. As potrace does, the
-//! cycle is cut at a fixed start vertex, which every candidate contains;
-//! potrace takes the path's first vertex, here the start whose greedy
-//! cover is shortest among [`START_TRIES`] spread round the loop (a greedy
-//! cover is optimal from a fixed start on monotone reaches), so the count
-//! is never worse than the greedy polygon flourish used before. From that
-//! start, `seg0`/`seg1` bound where the `j`-th vertex can be and a dynamic
-//! programme over them finds the least total penalty (potrace's
-//! `bestpolygon`; linear in practice).
+//! chord)`. As potrace does, the cycle is cut at a fixed start vertex,
+//! which every candidate contains; potrace takes the path's first vertex,
+//! here the start whose greedy cover is shortest among [`START_TRIES`]
+//! spread round the loop (a greedy cover is optimal from a fixed start on
+//! monotone reaches), so the count is never worse than the greedy polygon
+//! flourish used before. From that start, `seg0`/`seg1` bound where the
+//! `j`-th vertex can be and a dynamic programme over them finds the least
+//! total penalty (potrace's `bestpolygon`; linear in practice).
+//!
+//! **Arithmetic.** Path vertices are pixel-edge midpoints, so in doubled
+//! pixel coordinates ([`Lattice`]) they are integers, and everything up to
+//! the penalty's final square root is exact integer arithmetic. The sum in
+//! the penalty is `Σ (e × (v − m))²` with `e` the chord and `m` its
+//! midpoint; since `e × (r − m) = 0` for the chord's end `r`, it equals
+//! `Σ (u_k × u_t)²` with `u = v − r`, which needs only the three second
+//! moments of the `u` about `r`. For a fixed end `r` the search walks the
+//! candidate starts `k` backwards, so the moments grow by one vertex per
+//! candidate (the first read off prefix sums), and a candidate whose own
+//! total already reaches the best so far is skipped (penalties are ≥ 0).
+//! The value is the one the floating-point prefix sums gave, bit for bit,
+//! wherever those were exact: their terms are multiples of ¼ px², exact
+//! while the sums stay below 2⁵³ quarter units, which holds for the paths
+//! of rasters a few thousand pixels a side (tested on random loops; the 2
+//! Mpx ornament traces byte for byte as before). Beyond that the integer
+//! sums stay exact where the floating-point ones would have rounded.
 
+mod runs;
+
+#[cfg(test)]
+mod reference;
+
+pub(super) use runs::straight_runs;
+
+#[cfg(doc)]
 use super::binary::STRAIGHT_TOLERANCE;
-use kurbo::{Point, Vec2};
-use rayon::prelude::*;
+use kurbo::Point;
+use std::ops::{Add, Mul, Sub};
 
 /// Longest straight run considered, in path vertices (about 50–70 px of
-/// outline). The penalty search's work grows with the runs' lengths: per
-/// trace of the 2 Mpx ornament (callgrind) it costs 174 M instructions at
-/// 400 and 114 M at 100. Longer runs buy nothing downstream (a straight
-/// edge cut in two gets a smooth vertex on its line, and the curve fitter
-/// spans it): at 100 the 2 Mpx ornament traces byte for byte as at 400
-/// and the binary samples need the same segments. At 64 a 1.5-px
-/// diagonal loses a tenth of its weight
-/// (`binary_hairlines_keep_their_weight`).
+/// outline). The penalty search's work grows with the runs' lengths.
+/// Longer runs buy nothing downstream (a straight edge cut in two gets a
+/// smooth vertex on its line, and the curve fitter spans it): at 100 the
+/// 2 Mpx ornament traces byte for byte as at 400 and the binary samples
+/// need the same segments. At 64 a 1.5-px diagonal loses a tenth of its
+/// weight (`binary_hairlines_keep_their_weight`).
 const MAX_RUN: usize = 100;
 
 /// How many starts (spread evenly round the loop) the fewest-segment
 /// search tries before the penalty search runs from the best of them.
 pub(super) const START_TRIES: usize = 32;
 
-/// Step 2: `lon[i]` = how many vertices ahead of `i` a straight run from `i`
-/// reaches (at least 1).
-///
-/// The path's steps come in few directions, and long stretches repeat one
-/// (a pixel edge, a 45° staircase of edge midpoints). Along such a stretch
-/// every test below is settled by its two ends: a vertex's L∞ distance
-/// from a line through the anchor is affine along a straight stretch, the
-/// cone of admissible directions is an angular interval, and a stretch
-/// steps in one direction. So the walk jumps from stretch
-/// end to stretch end and only steps vertex by vertex through the stretch
-/// where the run ends. The result is the same as [`run_from`] applied at
-/// every vertex (tested).
-pub(super) fn straight_runs(path: &[Point]) -> Vec<usize> {
-    let runs = Runs::new(path);
-    if path.len() >= PARALLEL_RUNS {
-        // A long loop (an ornament's outline holds most of its vertices)
-        // is split across threads; the runs are collected in order.
-        (0..path.len())
-            .into_par_iter()
-            .with_min_len(PARALLEL_RUNS / 2)
-            .map(|i| runs.from(i))
-            .collect()
-    } else {
-        (0..path.len()).map(|i| runs.from(i)).collect()
+/// A path vertex (or a difference of two) on the half-pixel lattice, in
+/// doubled pixel coordinates: `(2x, 2y)`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(super) struct Lattice {
+    /// Twice the x coordinate (px).
+    pub(super) x: i64,
+    /// Twice the y coordinate (px).
+    pub(super) y: i64,
+}
+
+impl Lattice {
+    /// The lattice point of `p`, a pixel-edge midpoint (twice its
+    /// coordinates are integers, so the conversion is exact; anything
+    /// else is truncated towards zero).
+    pub(super) fn of(p: Point) -> Self {
+        Lattice {
+            x: (2.0 * p.x) as i64,
+            y: (2.0 * p.y) as i64,
+        }
+    }
+
+    /// The z component of the cross product `self × o`.
+    pub(super) fn cross(self, o: Lattice) -> i64 {
+        self.x * o.y - self.y * o.x
+    }
+
+    /// Which of eight directions, 45° apart (0 along +x, counting towards
+    /// +y), a step points in: from the signs of its components.
+    pub(super) fn direction(self) -> u8 {
+        match (self.x.signum(), self.y.signum()) {
+            (1, 0) => 0,
+            (1, 1) => 1,
+            (0, 1) => 2,
+            (-1, 1) => 3,
+            (-1, 0) => 4,
+            (-1, -1) => 5,
+            (0, -1) => 6,
+            _ => 7,
+        }
     }
 }
 
-/// Loops with at least this many vertices compute their runs in parallel.
-const PARALLEL_RUNS: usize = 4096;
-
-/// What the straight-run walk needs of a path, computed once: its steps'
-/// directions and how far each step repeats. [`Runs::from`] is then one
-/// vertex's run.
-pub(super) struct Runs<'a> {
-    path: &'a [Point],
-    /// The direction (of eight, [`direction`]) of the step into each vertex.
-    dirs: Vec<u8>,
-    /// `stretch[k]`: how many vertices ahead of `k` the step into `k + 1`
-    /// keeps repeating (at least 1).
-    stretch: Vec<usize>,
-}
-
-impl<'a> Runs<'a> {
-    /// The steps and stretches of `path`.
-    pub(super) fn new(path: &'a [Point]) -> Self {
-        let n = path.len();
-        let steps = path_steps(path);
-        let mut stretch = vec![1usize; n];
-        if n >= 3 {
-            let same = |k: usize| steps[(k + 1) % n].0 == steps[k].0;
-            // Walk backwards twice around the loop so the wrap is settled.
-            let mut len_after = vec![0usize; n]; // repeats of step k+1 after it
-            for pass in 0..2 {
-                for k in (0..n).rev() {
-                    let next = (k + 1) % n;
-                    let v = if same(next) {
-                        (len_after[next] + 1).min(n - 1)
-                    } else {
-                        0
-                    };
-                    if pass == 1 || v > len_after[k] {
-                        len_after[k] = v;
-                    }
-                }
-            }
-            for k in 0..n {
-                stretch[k] = len_after[k] + 1;
-            }
+impl Add for Lattice {
+    type Output = Lattice;
+    fn add(self, o: Lattice) -> Lattice {
+        Lattice {
+            x: self.x + o.x,
+            y: self.y + o.y,
         }
-        Runs {
-            path,
-            dirs: steps.iter().map(|s| direction(s.0) as u8).collect(),
-            stretch,
-        }
-    }
-
-    /// `lon[i]`: how many vertices ahead of `i` the straight run from `i`
-    /// reaches (at least 1).
-    pub(super) fn from(&self, i: usize) -> usize {
-        let (path, dirs, stretch) = (self.path, &self.dirs, &self.stretch);
-        let n = path.len();
-        let limit = n.min(MAX_RUN);
-        let wrap = |k: usize| if k >= n { k - n } else { k };
-        let mut run = Run::new(path[i]);
-        let mut j = i;
-        let mut m = 0usize;
-        loop {
-            let ahead = stretch[j];
-            // As far along the stretch as the run may go: its end, or the
-            // cap (a long straight edge reaches it from every vertex).
-            let reach = ahead.min(limit - 1 - m);
-            if reach >= 2 {
-                // The stretch's first step must advance, and the vertex
-                // reached must pass; then every vertex between passes too.
-                let e = wrap(j + reach);
-                if !run.advances(dirs[wrap(j + 1)]) {
-                    break;
-                }
-                if run.admits(path[e]) {
-                    m += reach;
-                    j = e;
-                    if !run.take(path[e]) || m + 1 >= limit {
-                        break;
-                    }
-                    continue;
-                }
-            }
-            // Vertex by vertex to the end of the stretch (or the cap).
-            let mut ended = false;
-            for _ in 0..ahead {
-                if m + 1 >= limit {
-                    ended = true;
-                    break;
-                }
-                let k = wrap(j + 1);
-                if !(run.advances(dirs[k]) && run.admits(path[k])) {
-                    ended = true;
-                    break;
-                }
-                m += 1;
-                j = k;
-                if !run.take(path[k]) {
-                    ended = true;
-                    break;
-                }
-            }
-            if ended {
-                break;
-            }
-        }
-        m.max(1)
     }
 }
 
-/// Each step of a closed path (from vertex k − 1 to vertex k) and its
-/// length.
-fn path_steps(path: &[Point]) -> Vec<(Vec2, f64)> {
-    let n = path.len();
-    (0..n)
-        .map(|k| {
-            let d = path[k] - path[(k + n - 1) % n];
-            (d, d.hypot())
-        })
-        .collect()
-}
-
-/// Which of eight directions, 45° apart (0 along +x, counting towards
-/// +y), a step of a path points in; from the signs of its components
-/// (a path's steps are along an axis or diagonal).
-fn direction(step: Vec2) -> u32 {
-    let sx = (step.x > 1e-9) as i32 - (step.x < -1e-9) as i32;
-    let sy = (step.y > 1e-9) as i32 - (step.y < -1e-9) as i32;
-    match (sx, sy) {
-        (1, 0) => 0,
-        (1, 1) => 1,
-        (0, 1) => 2,
-        (-1, 1) => 3,
-        (-1, 0) => 4,
-        (-1, -1) => 5,
-        (0, -1) => 6,
-        _ => 7,
+impl Sub for Lattice {
+    type Output = Lattice;
+    fn sub(self, o: Lattice) -> Lattice {
+        Lattice {
+            x: self.x - o.x,
+            y: self.y - o.y,
+        }
     }
 }
 
-/// The state of one straight run from an anchor vertex.
-struct Run {
-    anchor: Point,
-    /// The cone of admissible directions, as its right and left edge
-    /// vectors (counter-clockwise from right to left); None = any.
-    cone: Option<(Vec2, Vec2)>,
-    /// The directions (of eight) of the steps taken so far, as bits.
-    dirs: u8,
-}
-
-impl Run {
-    fn new(anchor: Point) -> Self {
-        Run {
-            anchor,
-            cone: None,
-            dirs: 0,
+impl Mul<i64> for Lattice {
+    type Output = Lattice;
+    fn mul(self, t: i64) -> Lattice {
+        Lattice {
+            x: self.x * t,
+            y: self.y * t,
         }
     }
-
-    /// Whether the step into `q` may join the run; records its direction.
-    ///
-    /// The steps of a run keep to two neighbouring directions of the eight
-    /// (potrace's rule that a straight path never steps in all four
-    /// directions, for paths that also step diagonally): a run does not
-    /// turn round the end of a line, whose two sides would otherwise be
-    /// one run within the tolerance of a 1-px line's vertices. Two such
-    /// directions are 45° apart, so every step advances along the run and
-    /// no vertex is nearer the anchor than one before it: a notch's back
-    /// step ends the run, and no further test is needed for that.
-    fn advances(&mut self, dir: u8) -> bool {
-        let bit = 1u8 << dir;
-        let near = bit | bit.rotate_left(1) | bit.rotate_right(1);
-        let dirs = self.dirs | bit;
-        if self.dirs & !near != 0 || dirs.count_ones() > 2 {
-            return false;
-        }
-        self.dirs = dirs;
-        true
-    }
-
-    /// Whether the segment from the anchor to `q` is a straight run over
-    /// the vertices taken so far: it passes through the box of each (its
-    /// direction is in the cone).
-    fn admits(&self, q: Point) -> bool {
-        let d = q - self.anchor;
-        match self.cone {
-            Some((r, l)) => r.cross(d) >= 0.0 && d.cross(l) >= 0.0,
-            None => true,
-        }
-    }
-
-    /// Takes `q` into the run, narrowing the cone to the directions that
-    /// pass through the box of half-side [`STRAIGHT_TOLERANCE`] round it;
-    /// false when nothing is left beyond.
-    fn take(&mut self, q: Point) -> bool {
-        let tol = STRAIGHT_TOLERANCE;
-        let d = q - self.anchor;
-        if d.x.abs() <= tol && d.y.abs() <= tol {
-            return true;
-        }
-        // The cone's new edges: the box's two corners that are outermost
-        // seen from the anchor (the box does not contain it, so they span
-        // less than 180°), picked by the signs of d as in potrace's
-        // calc_lon (right: counter-clockwise of it is admissible).
-        let sign = |c: bool| if c { tol } else { -tol };
-        let right = Vec2::new(
-            d.x + sign(d.y >= 0.0 && (d.y > 0.0 || d.x < 0.0)),
-            d.y + sign(d.x <= 0.0 && (d.x < 0.0 || d.y < 0.0)),
-        );
-        let left = Vec2::new(
-            d.x + sign(d.y <= 0.0 && (d.y < 0.0 || d.x < 0.0)),
-            d.y + sign(d.x >= 0.0 && (d.x > 0.0 || d.y < 0.0)),
-        );
-        self.cone = Some(match self.cone {
-            None => (right, left),
-            Some((r, l)) => {
-                let r2 = if r.cross(right) > 0.0 { right } else { r };
-                let l2 = if left.cross(l) > 0.0 { left } else { l };
-                if r2.cross(l2) < 0.0 {
-                    return false;
-                }
-                (r2, l2)
-            }
-        });
-        true
-    }
-}
-
-/// [`straight_runs`] at one vertex, vertex by vertex: the reference the
-/// stretch-jumping walk must agree with.
-#[cfg(test)]
-fn run_from(path: &[Point], i: usize) -> usize {
-    let n = path.len();
-    let steps = path_steps(path);
-    let mut run = Run::new(path[i]);
-    let mut best = 1;
-    for m in 1..n.min(MAX_RUN) {
-        let k = (i + m) % n;
-        if !(run.advances(direction(steps[k].0) as u8) && run.admits(path[k])) {
-            break;
-        }
-        best = m;
-        if !run.take(path[k]) {
-            break;
-        }
-    }
-    best
 }
 
 /// Possible segments: `ahead[i]` = how many vertices ahead of `i` the
@@ -328,23 +150,30 @@ fn run_from(path: &[Point], i: usize) -> usize {
 /// loop), so that `i → j` possible implies every `i' → j'` inside it is.
 /// At most `(n − 1) / 2` when the loop would otherwise close in two
 /// segments (a polygon needs three).
+#[inline(never)] // (once per path; kept whole in profiles)
 pub(super) fn possible_segments(lon: &[usize]) -> Vec<usize> {
     let n = lon.len();
     let mut ahead: Vec<usize> = lon.iter().map(|&l| l.clamp(1, n.max(2) - 1)).collect();
     if n < 2 {
         return ahead;
     }
-    // Two passes backwards round the loop settle the wrap: a reach is
-    // shorter than the loop, so a constraint travels less than once round.
-    for _ in 0..2 {
-        for i in (0..n).rev() {
-            let next = ahead[(i + 1) % n] + 1;
-            if next < ahead[i] {
-                ahead[i] = next;
-            }
-        }
+    // Backwards round the loop, then on across the wrap until nothing
+    // changes: a reach is shorter than the loop, so a constraint travels
+    // less than once round.
+    let mut next = ahead[0];
+    for a in ahead.iter_mut().rev() {
+        *a = (*a).min(next + 1);
+        next = *a;
     }
-    if n >= 4 && fewest_start(&ahead).1 < 3 {
+    let mut next = ahead[0];
+    for a in ahead.iter_mut().rev() {
+        if next + 1 >= *a {
+            break;
+        }
+        *a = next + 1;
+        next = *a;
+    }
+    if n >= 4 && closes_in_two(&ahead) {
         let cap = (n - 1) / 2;
         for a in ahead.iter_mut() {
             *a = (*a).min(cap);
@@ -353,37 +182,48 @@ pub(super) fn possible_segments(lon: &[usize]) -> Vec<usize> {
     ahead
 }
 
+/// The greedy cover of the loop from `start` over the reaches `ahead`: how
+/// many segments it has, counting up to `limit` at most.
+fn cover(ahead: &[usize], start: usize, limit: usize) -> usize {
+    let n = ahead.len();
+    let mut count = 1;
+    let mut at = 0usize; // steps from start
+    let mut i = start; // (start + at) mod n
+    while count < limit {
+        let step = ahead.get(i).map_or(1, |&a| a.max(1));
+        at += step;
+        if at >= n {
+            break;
+        }
+        // i, step < n: one wrap at most.
+        i += step;
+        if i >= n {
+            i -= n;
+        }
+        count += 1;
+    }
+    count
+}
+
+/// Whether the greedy cover from one of the [`fewest_start`] candidates
+/// closes the loop in fewer than three segments.
+fn closes_in_two(ahead: &[usize]) -> bool {
+    let n = ahead.len();
+    let tries = n.min(START_TRIES);
+    (0..tries).any(|k| cover(ahead, k * n / tries, 3) < 3)
+}
+
 /// The start (of [`START_TRIES`] spread round the loop) whose greedy
 /// cover has the fewest segments, and that count: the first such start.
+#[inline(never)] // (once per path; kept whole in profiles)
 pub(super) fn fewest_start(ahead: &[usize]) -> (usize, usize) {
     let n = ahead.len();
-    // The greedy cover from `start`: how many segments it has, counting up
-    // to `limit` at most.
-    let cover = |start: usize, limit: usize| -> usize {
-        let mut count = 1;
-        let mut at = 0usize; // steps from start
-        let mut i = start; // (start + at) mod n
-        while count < limit {
-            let step = ahead[i].max(1);
-            at += step;
-            if at >= n {
-                break;
-            }
-            // i, step < n: one wrap at most.
-            i += step;
-            if i >= n {
-                i -= n;
-            }
-            count += 1;
-        }
-        count
-    };
     // A cover stops counting as soon as it cannot beat the best so far.
     let tries = n.min(START_TRIES);
     let mut best = (0, usize::MAX);
     for k in 0..tries {
         let start = k * n / tries;
-        let count = cover(start, best.1);
+        let count = cover(ahead, start, best.1);
         if count < best.1 {
             best = (start, count);
         }
@@ -391,85 +231,112 @@ pub(super) fn fewest_start(ahead: &[usize]) -> (usize, usize) {
     best
 }
 
-/// Prefix sums of the path's coordinates (relative to the start vertex,
-/// taken `start`-first round the loop and back to it), for potrace's
-/// penalty in constant time.
-struct Sums {
-    /// `s[t]`: sums of x, y, x², xy, y² over the first `t` vertices.
-    s: Vec<[f64; 5]>,
-    /// The vertices, relative to the start, `n + 1` of them (the start
+/// The path's vertices from a start vertex round the loop and back to it,
+/// relative to it ([`Lattice`]), with prefix sums of their coordinates'
+/// products, for potrace's penalty.
+struct Chords {
+    /// The vertices relative to the start, `n + 1` of them (the start
     /// again last).
-    q: Vec<Vec2>,
+    v: Vec<Lattice>,
+    /// `s[t]`: sums of x, y, x², xy, y² over the first `t` vertices
+    /// (wrapping: only differences of nearby entries are read).
+    s: Vec<[i64; 5]>,
 }
 
-impl Sums {
+impl Chords {
     fn new(path: &[Point], start: usize) -> Self {
-        let n = path.len();
-        let q: Vec<Vec2> = (0..=n)
-            .map(|t| path[(start + t) % n] - path[start])
-            .collect();
-        let mut s = Vec::with_capacity(n + 2);
-        let mut acc = [0.0; 5];
+        let origin = path
+            .get(start)
+            .map_or(Lattice::default(), |&p| Lattice::of(p));
+        let (before, after) = path.split_at(start.min(path.len()));
+        let mut v = Vec::with_capacity(path.len() + 1);
+        let relative = |&p: &Point| Lattice::of(p) - origin;
+        v.extend(after.iter().map(relative));
+        v.extend(before.iter().map(relative));
+        v.extend(after.first().map(relative));
+        let mut s = Vec::with_capacity(v.len() + 1);
+        let mut acc = [0i64; 5];
         s.push(acc);
-        for v in &q {
-            acc[0] += v.x;
-            acc[1] += v.y;
-            acc[2] += v.x * v.x;
-            acc[3] += v.x * v.y;
-            acc[4] += v.y * v.y;
-            s.push(acc);
-        }
-        Sums { s, q }
+        s.extend(v.iter().map(|q| {
+            let terms = [q.x, q.y, q.x * q.x, q.x * q.y, q.y * q.y];
+            for (a, t) in acc.iter_mut().zip(terms) {
+                *a = a.wrapping_add(t);
+            }
+            acc
+        }));
+        Chords { v, s }
     }
 
-    /// potrace's penalty of the segment from relative vertex `i` to `j`
-    /// (`i < j ≤ n`): the chord's length times the root mean square
-    /// distance of the vertices `i ..= j` from the chord's line (Selinger
+    /// potrace's penalty of the segment from relative vertex `k` to `i`
+    /// (`k < i ≤ n`): the chord's length times the root mean square
+    /// distance of the vertices `k ..= i` from the chord's line (Selinger
     /// 2003, §2.2.2), px².
-    fn penalty(&self, i: usize, j: usize) -> f64 {
-        let (Some(a), Some(b)) = (self.s.get(i), self.s.get(j + 1)) else {
-            return f64::INFINITY;
-        };
-        let (Some(&p), Some(&r)) = (self.q.get(i), self.q.get(j)) else {
-            return f64::INFINITY;
-        };
-        let cnt = (j + 1 - i) as f64;
-        let [sx, sy, sxx, sxy, syy] = [
-            b[0] - a[0],
-            b[1] - a[1],
-            b[2] - a[2],
-            b[3] - a[3],
-            b[4] - a[4],
-        ];
-        let m = (p + r) * 0.5;
-        let e = r - p;
-        // Σ (e × (v − m))² = e_x² Σ(y − m_y)² − 2 e_x e_y Σ(x − m_x)(y − m_y)
-        // + e_y² Σ(x − m_x)².
-        let cxx = sxx - 2.0 * m.x * sx + cnt * m.x * m.x;
-        let cxy = sxy - m.x * sy - m.y * sx + cnt * m.x * m.y;
-        let cyy = syy - 2.0 * m.y * sy + cnt * m.y * m.y;
-        let s = e.x * e.x * cyy - 2.0 * e.x * e.y * cxy + e.y * e.y * cxx;
-        (s.max(0.0) / cnt).sqrt()
+    #[cfg(test)]
+    fn penalty(&self, k: usize, i: usize) -> f64 {
+        match (
+            self.v.get(k),
+            self.v.get(i),
+            self.s.get(k),
+            self.s.get(i + 1),
+        ) {
+            (Some(&p), Some(&r), Some(a), Some(b)) => {
+                let c = (i + 1 - k) as i64;
+                penalty(p - r, moments(a, b, r, c), c as f64)
+            }
+            _ => f64::INFINITY,
+        }
     }
+}
+
+/// The second moments `Σ u_x², Σ u_x u_y, Σ u_y²` of `u = v_t − r` over
+/// the `c` vertices whose sums of x, y, x², xy, y² are `end − start`.
+fn moments(start: &[i64; 5], end: &[i64; 5], r: Lattice, c: i64) -> [i64; 3] {
+    let d: [i64; 5] = std::array::from_fn(|t| end[t].wrapping_sub(start[t]));
+    [
+        d[2] - 2 * r.x * d[0] + c * r.x * r.x,
+        d[3] - r.x * d[1] - r.y * d[0] + c * r.x * r.y,
+        d[4] - 2 * r.y * d[1] + c * r.y * r.y,
+    ]
+}
+
+/// potrace's penalty from the chord `u` (start minus end, doubled
+/// coordinates), the second moments of the `cnt` vertices about the end
+/// ([`Chords::moments`]): `√(Σ (u × u_t)² / cnt)`, the doubled
+/// coordinates' factor 16 taken out exactly.
+#[cfg(test)]
+fn penalty(u: Lattice, [mxx, mxy, myy]: [i64; 3], cnt: f64) -> f64 {
+    root_mean(u.x * u.x * myy - 2 * u.x * u.y * mxy + u.y * u.y * mxx, cnt)
+}
+
+/// `√(s / 16 / cnt)`: the penalty from its exact sum `s` in doubled
+/// coordinates (the factor 16 is a power of two, so this is the value the
+/// sum in pixel units gives).
+fn root_mean(s: i64, cnt: f64) -> f64 {
+    (s as f64 * (1.0 / 16.0) / cnt).sqrt()
 }
 
 /// Step 3: the optimal polygon over the possible segments `ahead` (see
 /// [`possible_segments`]) of the closed `path`, as path indices in order
 /// from the start vertex: the fewest segments from the start, and of those
 /// the least total penalty (module docs; potrace's `bestpolygon`).
+#[inline(never)] // (once per path; kept whole in profiles)
 pub(super) fn optimal_polygon(path: &[Point], ahead: &[usize]) -> Vec<usize> {
     let n = path.len();
     if n < 3 || ahead.len() != n {
         return (0..n).collect();
     }
     let (start, _) = fewest_start(ahead);
-    let sums = Sums::new(path, start);
+    let chords = Chords::new(path, start);
     // clip0[i]: the farthest vertex a segment from i reaches; clip1[j]: the
     // nearest vertex a segment into j can start from (relative indices,
     // the start at 0 and again at n). Both are nondecreasing.
-    let clip0: Vec<usize> = (0..n)
-        .map(|i| (i + ahead[(start + i) % n].max(1)).min(n))
-        .collect();
+    let (before, after) = ahead.split_at(start);
+    let mut clip0 = Vec::with_capacity(n);
+    clip0.extend(after.iter().map(|&a| a.max(1)));
+    clip0.extend(before.iter().map(|&a| a.max(1)));
+    for (i, c) in clip0.iter_mut().enumerate() {
+        *c = (*c + i).min(n);
+    }
     let mut clip1 = vec![0usize; n + 1];
     let mut i = 0;
     for (j, c) in clip1.iter_mut().enumerate().skip(1) {
@@ -498,15 +365,33 @@ pub(super) fn optimal_polygon(path: &[Point], ahead: &[usize]) -> Vec<usize> {
     let mut pen = vec![f64::INFINITY; n + 1];
     let mut prev = vec![0usize; n + 1];
     pen[0] = 0.0;
+    // least[k]: the least total of layer j − 1 from seg1[j − 1] up to k,
+    // so the search into a vertex stops where no start below can win.
+    let mut least = vec![f64::INFINITY; n + 1];
     for j in 1..=m {
-        for i in seg1[j]..=seg0[j].min(n) {
-            let lo = clip1[i].max(seg1[j - 1]);
-            for k in (lo..=seg0[j - 1].min(i.saturating_sub(1))).rev() {
-                let p = pen[k] + sums.penalty(k, i);
-                if p < pen[i] {
-                    pen[i] = p;
-                    prev[i] = k;
-                }
+        let range = seg1[j - 1]..=seg0[j - 1].min(n);
+        if let (Some(totals), Some(lows)) = (pen.get(range.clone()), least.get_mut(range)) {
+            let mut low = f64::INFINITY;
+            for (l, &t) in lows.iter_mut().zip(totals) {
+                low = low.min(t);
+                *l = low;
+            }
+        }
+        let first = seg1[j];
+        let layer = clip1.get(first..=seg0[j].min(n)).unwrap_or_default();
+        for (i, &clip) in (first..).zip(layer) {
+            let hi = seg0[j - 1].min(i.saturating_sub(1));
+            let lo = clip.max(seg1[j - 1]);
+            // (Empty for i = 0, where potrace's loop only compares
+            // pen[0] with itself.)
+            let (before, rest) = pen.split_at_mut(i);
+            if let (Some(pens), Some(least), Some(best), Some(p)) = (
+                before.get(lo..=hi),
+                least.get(lo..=hi),
+                rest.first_mut(),
+                prev.get_mut(i),
+            ) {
+                (*best, *p) = best_start(&chords, (pens, least), lo, i, (*best, *p));
             }
         }
     }
@@ -520,8 +405,69 @@ pub(super) fn optimal_polygon(path: &[Point], ahead: &[usize]) -> Vec<usize> {
     out
 }
 
+/// The best start `k` of the last segment into relative vertex `i`, of the
+/// candidates `lo ..= lo + pens.len() − 1` (whose totals are `pens`),
+/// tried from the far end down as in potrace: the least `pen[k] + P(k, i)`
+/// and its `k`, the first found on ties; `best` if none beats it.
+///
+/// Walking down, the moments about `v_i` grow by one vertex per candidate
+/// (the first read off the prefix sums). `P(k, i) ≥ 0`, so a candidate
+/// whose own total is no better than the best so far cannot win and its
+/// penalty is not evaluated; the walk stops where `least` (each
+/// candidate's lower bound on the totals from it down) reaches the best.
+#[inline(never)] // (once per path; kept whole in profiles)
+fn best_start(
+    chords: &Chords,
+    (pens, least): (&[f64], &[f64]),
+    lo: usize,
+    i: usize,
+    mut best: (f64, usize),
+) -> (f64, usize) {
+    let Some(hi) = (lo + pens.len()).checked_sub(1).filter(|&hi| hi >= lo) else {
+        return best;
+    };
+    let (Some(vs), Some(&r), Some(a), Some(b)) = (
+        chords.v.get(lo..=hi),
+        chords.v.get(i),
+        chords.s.get(hi),
+        chords.s.get(i + 1),
+    ) else {
+        return best;
+    };
+    // The moments about r of the vertices hi ..= i; each candidate below
+    // adds its own vertex.
+    let c = i + 1 - hi;
+    let [mut mxx, mut mxy, mut myy] = moments(a, b, r, c as i64);
+    let mut cnt = c as f64;
+    let mut k = hi;
+    for ((&v, &pk), &low) in vs.iter().zip(pens).zip(least).rev() {
+        if low >= best.0 {
+            // No start from here down has a total below the best.
+            break;
+        }
+        let u = v - r;
+        let (xx, xy, yy) = (u.x * u.x, u.x * u.y, u.y * u.y);
+        if k < hi {
+            mxx += xx;
+            mxy += xy;
+            myy += yy;
+            cnt += 1.0;
+        }
+        if pk < best.0 {
+            // Σ (u × u_t)² (module docs).
+            let p = pk + root_mean(xx * myy - 2 * xy * mxy + yy * mxx, cnt);
+            if p < best.0 {
+                best = (p, k);
+            }
+        }
+        k = k.wrapping_sub(1);
+    }
+    best
+}
+
 #[cfg(test)]
 mod tests {
+    use super::reference::{self, Sums};
     use super::*;
     use crate::raster::binary::smooth_outline;
     use crate::raster::Grid;
@@ -556,6 +502,13 @@ mod tests {
         best
     }
 
+    /// Points on the half-pixel lattice from doubled coordinates.
+    fn lattice_path(pts: &[(i32, i32)]) -> Vec<Point> {
+        pts.iter()
+            .map(|&(x, y)| Point::new(f64::from(x) / 2.0, f64::from(y) / 2.0))
+            .collect()
+    }
+
     proptest::proptest! {
         /// The dynamic programme finds the polygon the exhaustive search
         /// over vertex subsets finds: from its start vertex, the same
@@ -563,10 +516,10 @@ mod tests {
         /// on loops this small) no polygon at all has fewer segments.
         #[test]
         fn penalty_polygon_equals_exhaustive_search(
-            pts in proptest::collection::vec((0.0f64..10.0, 0.0f64..10.0), 4..13),
+            pts in proptest::collection::vec((0i32..20, 0i32..20), 4..13),
             lon in proptest::collection::vec(1usize..8, 13),
         ) {
-            let path: Vec<Point> = pts.iter().map(|&(x, y)| Point::new(x, y)).collect();
+            let path = lattice_path(&pts);
             let n = path.len();
             let ahead = possible_segments(&lon[..n]);
             // Monotone: a possible segment's sub-segments are possible.
@@ -575,6 +528,7 @@ mod tests {
                 proptest::prop_assert!(ahead[i] >= 1 && ahead[i] <= lon[i].max(1));
             }
             let poly = optimal_polygon(&path, &ahead);
+            proptest::prop_assert_eq!(&poly, &reference::optimal_polygon(&path, &ahead));
             let start = poly[0];
             let sums = Sums::new(&path, start);
             let mut pen = 0.0;
@@ -591,100 +545,129 @@ mod tests {
             proptest::prop_assert_eq!(brute_force(&path, &ahead, None).0, count);
         }
 
-        /// The penalty read off prefix sums is the chord length times the
-        /// root mean square distance of the vertices from the chord.
+        /// The lattice penalty is the chord length times the root mean
+        /// square distance of the vertices from the chord, and bit for bit
+        /// the floating-point prefix sums' value.
         #[test]
-        fn penalty_from_sums_is_direct(
-            pts in proptest::collection::vec((-50.0f64..50.0, -50.0f64..50.0), 3..30),
+        fn lattice_penalty_is_direct_and_equals_the_float_sums(
+            pts in proptest::collection::vec((-100i32..100, -100i32..100), 3..30),
             start in 0usize..30, i in 0usize..30, len in 1usize..30,
         ) {
-            let path: Vec<Point> = pts.iter().map(|&(x, y)| Point::new(x, y)).collect();
+            let path = lattice_path(&pts);
             let n = path.len();
             let (start, i) = (start % n, i % n);
             let j = (i + len).min(n);
             proptest::prop_assume!(j > i);
-            let sums = Sums::new(&path, start);
             let at = |t: usize| path[(start + t) % n];
             let e = at(j) - at(i);
             let m = at(i).midpoint(at(j));
             let direct = ((i..=j).map(|t| e.cross(at(t) - m).powi(2)).sum::<f64>()
                 / (j + 1 - i) as f64)
                 .sqrt();
-            // Squares compared: the sums cancel to within rounding of
-            // |e|² times the coordinates' squares (100² here).
-            let p = sums.penalty(i, j);
-            proptest::prop_assert!((p * p - direct * direct).abs() < 1e-8 * (1.0 + e.hypot2()) * 1e4);
+            let p = Chords::new(&path, start).penalty(i, j);
+            proptest::prop_assert!((p * p - direct * direct).abs() < 1e-9 * (1.0 + direct * direct));
+            let float = Sums::new(&path, start).penalty(i, j);
+            proptest::prop_assert_eq!(p.to_bits(), float.to_bits());
+        }
+
+        /// The possible segments are the fixpoint of potrace's clean-up,
+        /// `ahead[i] = min(lon[i], ahead[i + 1] + 1)` round the loop (every
+        /// reach clamped to the loop), less the cap for loops that would
+        /// close in two segments: as two full backward passes give them.
+        #[test]
+        fn possible_segments_are_the_cleanup_fixpoint(
+            lon in proptest::collection::vec(1usize..40, 1..60),
+        ) {
+            let n = lon.len();
+            let mut want: Vec<usize> = lon.iter().map(|&l| l.clamp(1, n.max(2) - 1)).collect();
+            for _ in 0..2 {
+                for i in (0..n).rev() {
+                    want[i] = want[i].min(want[(i + 1) % n] + 1);
+                }
+            }
+            if n >= 4 && fewest_start(&want).1 < 3 {
+                for a in want.iter_mut() {
+                    *a = (*a).min((n - 1) / 2);
+                }
+            }
+            proptest::prop_assert_eq!(possible_segments(&lon), want);
         }
     }
 
-    /// The stretch-jumping walk gives the vertex-by-vertex runs exactly,
-    /// on the loops of random blobs (every kind of staircase and corner),
-    /// and every run is straight by the definition.
+    /// A union of random discs and slanted bars, rasterized on a
+    /// `size`² grid.
+    fn random_blobs(size: usize, rnd: &mut impl FnMut() -> f64) -> Grid<f32> {
+        let scale = size as f64 / 64.0;
+        let shapes: Vec<(f64, f64, f64, f64)> = (0..5)
+            .map(|_| {
+                let (cx, cy) = (rnd() * 60.0 * scale, rnd() * 60.0 * scale);
+                (cx, cy, (3.0 + rnd() * 15.0) * scale, rnd())
+            })
+            .collect();
+        Grid::from_fn(size, size, |x, y| {
+            let (x, y) = (x as f64 + 0.5, y as f64 + 0.5);
+            let hit = shapes.iter().any(|&(cx, cy, r, k)| {
+                if k < 0.5 {
+                    (x - cx).hypot(y - cy) <= r
+                } else {
+                    let slope = 4.0 * k - 3.0;
+                    ((y - cy) - slope * (x - cx)).abs() < 0.3 * r && (x - cx).abs() < 2.0 * r
+                }
+            });
+            if hit {
+                1.0
+            } else {
+                0.0
+            }
+        })
+    }
+
+    /// On the loops of random blobs (real pixel-edge paths, up to a few
+    /// thousand vertices), the lattice search gives the floating-point
+    /// search's polygon exactly, and every candidate's penalty is the
+    /// float sums' bit for bit.
     #[test]
-    fn jumping_runs_equal_the_vertex_by_vertex_reference() {
-        let mut seed = 0x9e3779b97f4a7c15u64;
+    fn lattice_polygon_equals_the_float_reference() {
+        let mut seed = 0x2545f4914f6cdd1du64;
         let mut rnd = move || {
             seed ^= seed << 13;
             seed ^= seed >> 7;
             seed ^= seed << 17;
             (seed >> 11) as f64 / (1u64 << 53) as f64
         };
-        let mut checked = 0;
-        for _ in 0..40 {
-            // A union of random discs and slanted bars, rasterized.
-            let shapes: Vec<(f64, f64, f64, f64)> = (0..4)
-                .map(|_| (rnd() * 60.0, rnd() * 60.0, 3.0 + rnd() * 15.0, rnd()))
-                .collect();
-            let cov = Grid::from_fn(64, 64, |x, y| {
-                let (x, y) = (x as f64 + 0.5, y as f64 + 0.5);
-                let hit = shapes.iter().any(|&(cx, cy, r, k)| {
-                    if k < 0.5 {
-                        (x - cx).hypot(y - cy) <= r
-                    } else {
-                        let slope = 4.0 * k - 3.0;
-                        ((y - cy) - slope * (x - cx)).abs() < 0.3 * r && (x - cx).abs() < 2.0 * r
-                    }
-                });
-                if hit {
-                    1.0
-                } else {
-                    0.0
-                }
-            });
+        let (mut loops, mut vertices) = (0, 0);
+        for round in 0..24 {
+            let cov = random_blobs(if round % 3 == 0 { 400 } else { 96 }, &mut rnd);
             let values = cov.map(|c| if c >= 0.5 { -0.5 } else { 0.5 });
             for c in contour::extract(&values) {
                 let path = &c.points;
-                let fast = straight_runs(path);
-                for (i, &lon) in fast.iter().enumerate() {
-                    assert_eq!(lon, run_from(path, i), "vertex {i} of {}", path.len());
-                    checked += 1;
-                }
-                // Every run is straight by the definition itself: the
-                // chord passes through the box round every vertex, and the
-                // steps keep to two neighbouring directions.
                 let n = path.len();
-                for (i, &m) in fast.iter().enumerate() {
-                    let d = path[(i + m) % n] - path[i];
-                    let l1 = d.x.abs() + d.y.abs();
-                    let mut dirs = 0u8;
-                    for k in 1..=m {
-                        let q = path[(i + k) % n] - path[i];
-                        assert!(d.cross(q).abs() <= STRAIGHT_TOLERANCE * l1 + 1e-9);
-                        dirs |= 1 << direction(path[(i + k) % n] - path[(i + k + n - 1) % n]);
-                    }
-                    assert!(
-                        dirs.count_ones() <= 2
-                            && (dirs.count_ones() < 2 || {
-                                let lo = dirs.trailing_zeros();
-                                let hi = 7 - dirs.leading_zeros();
-                                hi - lo == 1 || (lo == 0 && hi == 7)
-                            }),
-                        "run {i}+{m} steps in directions {dirs:08b}"
-                    );
+                if n < 4 {
+                    continue;
                 }
+                let ahead = possible_segments(&straight_runs(path));
+                let poly = optimal_polygon(path, &ahead);
+                assert_eq!(
+                    poly,
+                    reference::optimal_polygon(path, &ahead),
+                    "{n} vertices"
+                );
+                let start = fewest_start(&ahead).0;
+                let (fast, float) = (Chords::new(path, start), Sums::new(path, start));
+                for i in (1..=n).step_by(7) {
+                    for k in i.saturating_sub(MAX_RUN)..i {
+                        let (p, q) = (fast.penalty(k, i), float.penalty(k, i));
+                        assert_eq!(p.to_bits(), q.to_bits(), "P({k}, {i}) of {n}");
+                    }
+                }
+                loops += 1;
+                vertices += n;
             }
         }
-        assert!(checked > 5000, "only {checked} vertices");
+        assert!(
+            loops > 40 && vertices > 20_000,
+            "{loops} loops, {vertices} vertices"
+        );
     }
 
     /// The one closed path round the ink of a bitmap with one island.
@@ -693,29 +676,6 @@ mod tests {
         let mut cs = contour::extract(&values);
         assert_eq!(cs.len(), 1);
         cs.remove(0).points
-    }
-
-    /// Along an edge longer than [`MAX_RUN`] vertices (a bar 300 px
-    /// long), every run stops at the cap, jumping there in one step, and
-    /// agrees with the vertex-by-vertex reference.
-    #[test]
-    fn runs_along_a_long_edge_stop_at_the_cap() {
-        let cov = Grid::from_fn(320, 12, |x, y| {
-            if (10..310).contains(&x) && (4..8).contains(&y) {
-                1.0
-            } else {
-                0.0
-            }
-        });
-        let path = &only_path(&cov);
-        let runs = Runs::new(path);
-        let mut capped = 0;
-        for i in 0..path.len() {
-            let lon = runs.from(i);
-            assert_eq!(lon, run_from(path, i), "vertex {i}");
-            capped += usize::from(lon == MAX_RUN - 1);
-        }
-        assert!(capped > 300, "{capped} runs reach the cap");
     }
 
     #[test]
@@ -737,7 +697,7 @@ mod tests {
         let n = path.len();
         let lon = straight_runs(path);
         for (i, &m) in lon.iter().enumerate() {
-            assert_eq!(m, run_from(path, i));
+            assert_eq!(m, reference::run_from(path, i));
         }
         let longest = lon.iter().copied().max().unwrap_or(0);
         assert!(longest >= 8, "longest run {longest} of {n}");
@@ -747,7 +707,10 @@ mod tests {
             let d = path[(i + m) % n] - path[i];
             for k in 0..=m {
                 let off = d.cross(path[(i + k) % n] - path[i]).abs() / (d.x.abs() + d.y.abs());
-                assert!(off <= STRAIGHT_TOLERANCE + 1e-9, "run {i}+{m}: {off}");
+                assert!(
+                    off <= crate::raster::binary::STRAIGHT_TOLERANCE + 1e-9,
+                    "run {i}+{m}: {off}"
+                );
             }
         }
         // The polygon needs far fewer vertices than the path.

@@ -128,12 +128,16 @@ fn box_minimum(v: Point, lines: &[(Point, Vec2)]) -> Point {
 
 /// Total least squares line through `pts`: centroid and principal direction
 /// (oriented from `a` to `b`).
-fn fit_line(pts: impl Iterator<Item = Point>, a: Point, b: Point) -> (Point, Vec2) {
-    let pts: Vec<Point> = pts.collect();
-    let m = pts.len().max(1) as f64;
-    let c = pts.iter().fold(Vec2::ZERO, |s, p| s + p.to_vec2()) / m;
+/// The points are walked twice (centroid, then moments about it) rather
+/// than collected.
+fn fit_line(pts: impl Iterator<Item = Point> + Clone, a: Point, b: Point) -> (Point, Vec2) {
+    let (count, sum) = pts
+        .clone()
+        .fold((0usize, Vec2::ZERO), |(k, s), p| (k + 1, s + p.to_vec2()));
+    let m = count.max(1) as f64;
+    let c = sum / m;
     let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
-    for p in &pts {
+    for p in pts {
         let d = p.to_vec2() - c;
         sxx += d.x * d.x;
         sxy += d.x * d.y;
@@ -145,7 +149,7 @@ fn fit_line(pts: impl Iterator<Item = Point>, a: Point, b: Point) -> (Point, Vec
     if chord.hypot() > 1e-9 && d.dot(chord) < 0.0 {
         d = -d;
     }
-    if pts.len() < 2 || !d.x.is_finite() {
+    if count < 2 || !d.x.is_finite() {
         let l = chord.hypot();
         d = if l > 1e-9 {
             chord / l
