@@ -217,7 +217,13 @@ pub(super) fn fit_span_direct(
             p3,
         );
         let scale = scale(d0).max(scale(d1));
-        *r = (scale, rough_error(&c, samples) * scale, c);
+        // A lone candidate needs no rank.
+        let rough = if k > 1 {
+            rough_error(&c, samples) * scale
+        } else {
+            0.0
+        };
+        *r = (scale, rough, c);
     }
     let ranked = ranked.get_mut(..k).unwrap_or(&mut []);
     ranked.sort_by(|a, b| a.1.total_cmp(&b.1));
