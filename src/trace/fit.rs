@@ -245,6 +245,17 @@ impl<'a> Piece<'a> {
                         }
                     }
                     anchor = None;
+                    // The cursor's own segment outright, as the search
+                    // below would measure it first (most points lie
+                    // within `near` of it), without the search's setup.
+                    if cursor <= hi && cursor + 1 < self.pts.len() {
+                        let seg = kurbo::Line::new(self.pts[cursor], self.pts[cursor + 1]);
+                        let d = crate::raster::sdf::point_segment_distance(p, seg);
+                        if d <= near {
+                            anchor = Some((p, near - d));
+                            return true;
+                        }
+                    }
                     // Ahead of the cursor first (where the curve goes on);
                     // a point within `far` there that the corridor admits
                     // passes without the search behind it.
