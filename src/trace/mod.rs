@@ -232,10 +232,16 @@ pub fn trace_bitmap(bits: &Bitmap, opts: &TraceOptions) -> Vec<BezPath> {
     let (islands, mut fitted) = rayon::join(
         || nest_polygons(&polys, &areas, opts.min_area),
         || {
-            paths
+            // Longest paths first, one task each, so the largest outline
+            // does not start last and leave the other threads idle; the
+            // results go back to their paths' places.
+            let mut order: Vec<usize> = (0..paths.len()).collect();
+            order.sort_by_key(|&i| std::cmp::Reverse(paths[i].len()));
+            let mut done: Vec<(usize, BezPath)> = order
                 .par_iter()
-                .zip(&areas)
-                .map(|(p, &area)| {
+                .with_max_len(1)
+                .map(|&i| {
+                    let (p, area) = (&paths[i], areas[i]);
                     let mut path = BezPath::new();
                     if area.abs() >= opts.min_area {
                         let l = binary::smooth_loop(p);
@@ -250,9 +256,11 @@ pub fn trace_bitmap(bits: &Bitmap, opts: &TraceOptions) -> Vec<BezPath> {
                             );
                         }
                     }
-                    path
+                    (i, path)
                 })
-                .collect::<Vec<BezPath>>()
+                .collect();
+            done.sort_unstable_by_key(|d| d.0);
+            done.into_iter().map(|d| d.1).collect::<Vec<BezPath>>()
         },
     );
     assemble(&islands, &mut fitted)
