@@ -18,7 +18,8 @@
 //!    of the eight (potrace's straight paths, Selinger 2003, §2.2.1, as its
 //!    implementation anchors them; the direction rule keeps a run from
 //!    turning round a line's end). A cone of admissible directions is
-//!    narrowed vertex by vertex, jumping along repeated steps.
+//!    narrowed from stretch to stretch of repeated steps, in exact integer
+//!    arithmetic on doubled pixel coordinates.
 //! 3. **Optimal polygon** (§2.2.2). Reaches made monotone (every
 //!    sub-segment of a possible segment is possible), then the fewest
 //!    segments round the loop and, of those, the least sum of potrace's
@@ -41,11 +42,13 @@
 //!    neighbours, measured in pixel-square units, and a vertex with
 //!    `α ≥` [`ALPHA_MAX`] stays a corner (potrace's `alphamax`).
 //!
-//! 6. **Relaxing.** The flattened curves are smoothed along their arc
-//!    length between corners (a biweight of radius `RELAX_RADIUS`, with
-//!    Taubin's inflating second pass so loops do not shrink): step 5's
-//!    cubics bunch their turning next to the polygon vertices, and a
-//!    fitter that follows them needs more curves than the drawing had.
+//! 6. **Relaxing.** The curves are flattened at `FLATTEN` (0.1 px), each
+//!    point moved out so the chords keep the curve's area, and smoothed
+//!    along their arc length between corners (a biweight of radius
+//!    `RELAX_RADIUS`, with Taubin's inflating second pass so loops do not
+//!    shrink): step 5's cubics bunch their turning next to the polygon
+//!    vertices, and a fitter that follows them needs more curves than the
+//!    drawing had.
 //!    Tangents are taken as chords over ±`TANGENT_REACH` px.
 //!
 //! `flourish trace` fits Béziers to these loops directly

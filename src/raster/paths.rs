@@ -328,6 +328,21 @@ mod tests {
     use crate::trace::contour;
     use proptest::prelude::*;
 
+    /// A random `w` × `h` bitmap, ink with probability `density` per pixel
+    /// (per 5 × 3 block when `blocky`), hashed from `seed`.
+    fn random_bits(w: usize, h: usize, density: f64, blocky: bool, seed: u64) -> Bitmap {
+        Bitmap::from_fn(w, h, |x, y| {
+            let (x, y) = if blocky { (x / 5, y / 3) } else { (x, y) };
+            let mut z = seed
+                ^ (x as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)
+                ^ (y as u64).wrapping_mul(0xc2b2_ae3d_27d4_eb4f);
+            z ^= z >> 31;
+            z = z.wrapping_mul(0xbf58_476d_1ce4_e5b9);
+            z ^= z >> 29;
+            ((z >> 11) as f64 / (1u64 << 53) as f64) < density
+        })
+    }
+
     /// The reference: marching squares on the ±½ field.
     fn reference(bits: &Bitmap) -> Vec<Vec<Point>> {
         let values = Grid::from_fn(bits.width(), bits.height(), |x, y| {
@@ -393,15 +408,7 @@ mod tests {
             blocky in any::<bool>(),
             seed in any::<u64>(),
         ) {
-            let bits = Bitmap::from_fn(w, h, |x, y| {
-                let (x, y) = if blocky { (x / 5, y / 3) } else { (x, y) };
-                let mut z = seed ^ (x as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)
-                    ^ (y as u64).wrapping_mul(0xc2b2_ae3d_27d4_eb4f);
-                z ^= z >> 31;
-                z = z.wrapping_mul(0xbf58_476d_1ce4_e5b9);
-                z ^= z >> 29;
-                ((z >> 11) as f64 / (1u64 << 53) as f64) < density
-            });
+            let bits = random_bits(w, h, density, blocky, seed);
             prop_assert_eq!(paths(&bits), reference(&bits));
         }
 
@@ -415,14 +422,7 @@ mod tests {
             density in 0.05f64..0.95,
             seed in any::<u64>(),
         ) {
-            let bits = Bitmap::from_fn(w, h, |x, y| {
-                let mut z = seed ^ (x as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15)
-                    ^ (y as u64).wrapping_mul(0xc2b2_ae3d_27d4_eb4f);
-                z ^= z >> 31;
-                z = z.wrapping_mul(0xbf58_476d_1ce4_e5b9);
-                z ^= z >> 29;
-                ((z >> 11) as f64 / (1u64 << 53) as f64) < density
-            });
+            let bits = random_bits(w, h, density, false, seed);
             let ink = (0..w * h)
                 .filter(|&i| bits.ink((i % w) as isize, (i / w) as isize))
                 .count();

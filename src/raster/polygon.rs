@@ -101,16 +101,22 @@ impl Lattice {
     /// Which of eight directions, 45° apart (0 along +x, counting towards
     /// +y), a step points in: from the signs of its components.
     pub(super) fn direction(self) -> u8 {
-        match (self.x.signum(), self.y.signum()) {
-            (1, 0) => 0,
-            (1, 1) => 1,
-            (0, 1) => 2,
-            (-1, 1) => 3,
-            (-1, 0) => 4,
-            (-1, -1) => 5,
-            (0, -1) => 6,
-            _ => 7,
-        }
+        octant(self.x.signum() as i32, self.y.signum() as i32)
+    }
+}
+
+/// The direction (of eight, 45° apart: 0 along +x, counting towards +y)
+/// of a step whose components have the signs `sx`, `sy` (−1, 0 or 1).
+pub(super) fn octant(sx: i32, sy: i32) -> u8 {
+    match (sx, sy) {
+        (1, 0) => 0,
+        (1, 1) => 1,
+        (0, 1) => 2,
+        (-1, 1) => 3,
+        (-1, 0) => 4,
+        (-1, -1) => 5,
+        (0, -1) => 6,
+        _ => 7,
     }
 }
 
@@ -594,11 +600,15 @@ mod tests {
         }
     }
 
-    /// A union of random discs and slanted bars, rasterized on a
+    /// A union of `count` random discs and slanted bars, rasterized on a
     /// `size`² grid.
-    fn random_blobs(size: usize, rnd: &mut impl FnMut() -> f64) -> Grid<f32> {
+    pub(super) fn random_blobs(
+        size: usize,
+        count: usize,
+        rnd: &mut impl FnMut() -> f64,
+    ) -> Grid<f32> {
         let scale = size as f64 / 64.0;
-        let shapes: Vec<(f64, f64, f64, f64)> = (0..5)
+        let shapes: Vec<(f64, f64, f64, f64)> = (0..count)
             .map(|_| {
                 let (cx, cy) = (rnd() * 60.0 * scale, rnd() * 60.0 * scale);
                 (cx, cy, (3.0 + rnd() * 15.0) * scale, rnd())
@@ -637,7 +647,7 @@ mod tests {
         };
         let (mut loops, mut vertices) = (0, 0);
         for round in 0..24 {
-            let cov = random_blobs(if round % 3 == 0 { 400 } else { 96 }, &mut rnd);
+            let cov = random_blobs(if round % 3 == 0 { 400 } else { 96 }, 5, &mut rnd);
             let values = cov.map(|c| if c >= 0.5 { -0.5 } else { 0.5 });
             for c in contour::extract(&values) {
                 let path = &c.points;

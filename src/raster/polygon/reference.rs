@@ -12,16 +12,7 @@ use kurbo::{Point, Vec2};
 pub(super) fn direction(step: Vec2) -> u8 {
     let sx = (step.x > 1e-9) as i32 - (step.x < -1e-9) as i32;
     let sy = (step.y > 1e-9) as i32 - (step.y < -1e-9) as i32;
-    match (sx, sy) {
-        (1, 0) => 0,
-        (1, 1) => 1,
-        (0, 1) => 2,
-        (-1, 1) => 3,
-        (-1, 0) => 4,
-        (-1, -1) => 5,
-        (0, -1) => 6,
-        _ => 7,
-    }
+    super::octant(sx, sy)
 }
 
 /// One straight run from an anchor, in floating point.

@@ -313,29 +313,7 @@ mod tests {
             // A union of random discs and slanted bars, rasterized; the
             // later rounds larger, so long shallow staircases occur.
             let size = if round < 40 { 64 } else { 200 };
-            let scale = size as f64 / 64.0;
-            let shapes: Vec<(f64, f64, f64, f64)> = (0..4)
-                .map(|_| {
-                    let (cx, cy) = (rnd() * 60.0 * scale, rnd() * 60.0 * scale);
-                    (cx, cy, (3.0 + rnd() * 15.0) * scale, rnd())
-                })
-                .collect();
-            let cov = Grid::from_fn(size, size, |x, y| {
-                let (x, y) = (x as f64 + 0.5, y as f64 + 0.5);
-                let hit = shapes.iter().any(|&(cx, cy, r, k)| {
-                    if k < 0.5 {
-                        (x - cx).hypot(y - cy) <= r
-                    } else {
-                        let slope = 4.0 * k - 3.0;
-                        ((y - cy) - slope * (x - cx)).abs() < 0.3 * r && (x - cx).abs() < 2.0 * r
-                    }
-                });
-                if hit {
-                    1.0
-                } else {
-                    0.0
-                }
-            });
+            let cov = crate::raster::polygon::tests::random_blobs(size, 4, &mut rnd);
             for path in &paths_of(&cov) {
                 let fast = straight_runs(path);
                 for (i, &lon) in fast.iter().enumerate() {
