@@ -216,9 +216,11 @@ fn smooth_polygon(v: &[Point], keep: &[bool]) -> SmoothLoop {
             let alpha = alpha.clamp(0.55, 1.0);
             let c = CubicBez::new(m1, m1 + (p - m1) * alpha, m2 + (p - m2) * alpha, m2);
             let steps = cubic_steps(&c);
+            let (c1, c2) = (c.deriv(), c.deriv().deriv());
+            let h = 1.0 / steps as f64;
             for s in 0..steps {
                 let t = s as f64 / steps as f64;
-                let d = c.deriv().eval(t).to_vec2();
+                let d = c1.eval(t).to_vec2();
                 // At a degenerate end the chord of the edge is the tangent.
                 let d = if d.hypot() > 1e-9 {
                     d
@@ -227,6 +229,7 @@ fn smooth_polygon(v: &[Point], keep: &[bool]) -> SmoothLoop {
                 } else {
                     b - p
                 };
+                let u = unit(d);
                 let mut q = c.eval(t);
                 if s > 0 {
                     // The chords either side cut inside the curve by its
@@ -235,13 +238,11 @@ fn smooth_polygon(v: &[Point], keep: &[bool]) -> SmoothLoop {
                     // area between a chord and its arc is 2/3 of sagitta ×
                     // chord, so moving each point out by 2/3 of the sagitta
                     // keeps the area the curve encloses.
-                    let dd = c.deriv().deriv().eval(t).to_vec2();
-                    let u = unit(d);
+                    let dd = c2.eval(t).to_vec2();
                     let n = dd - u * dd.dot(u);
-                    let h = 1.0 / steps as f64;
                     q -= n * (h * h / 8.0 * 2.0 / 3.0);
                 }
-                push(&mut out, q, unit(d), false);
+                push(&mut out, q, u, false);
             }
         }
     }
