@@ -333,38 +333,8 @@ pub(super) fn optimal_polygon(path: &[Point], ahead: &[usize]) -> Vec<usize> {
     }
     let (start, _) = fewest_start(ahead);
     let chords = Chords::new(path, start);
-    // clip0[i]: the farthest vertex a segment from i reaches; clip1[j]: the
-    // nearest vertex a segment into j can start from (relative indices,
-    // the start at 0 and again at n). Both are nondecreasing.
-    let (before, after) = ahead.split_at(start);
-    let mut clip0 = Vec::with_capacity(n);
-    clip0.extend(after.iter().map(|&a| a.max(1)));
-    clip0.extend(before.iter().map(|&a| a.max(1)));
-    for (i, c) in clip0.iter_mut().enumerate() {
-        *c = (*c + i).min(n);
-    }
-    let mut clip1 = vec![0usize; n + 1];
-    let mut i = 0;
-    for (j, c) in clip1.iter_mut().enumerate().skip(1) {
-        while clip0.get(i).is_some_and(|&c0| c0 < j) {
-            i += 1;
-        }
-        *c = i;
-    }
-    // seg0[j]: the farthest vertex j segments reach from 0; seg1[j]: the
-    // nearest vertex from which n is reached in m − j segments.
-    let mut seg0 = vec![0usize];
-    let mut at = 0;
-    while at < n {
-        at = clip0.get(at).copied().unwrap_or(n);
-        seg0.push(at);
-    }
+    let Bounds { clip1, seg0, seg1 } = Bounds::new(ahead, start);
     let m = seg0.len() - 1;
-    let mut seg1 = vec![0usize; m + 1];
-    seg1[m] = n;
-    for j in (1..=m).rev() {
-        seg1[j - 1] = clip1.get(seg1[j]).copied().unwrap_or(0);
-    }
     // pen[i]: the least total penalty of j segments from 0 to i, for i in
     // seg1[j] ..= seg0[j] (these ranges are disjoint for different j, as
     // in potrace); prev[i]: the vertex before i on that polygon.
@@ -409,6 +379,57 @@ pub(super) fn optimal_polygon(path: &[Point], ahead: &[usize]) -> Vec<usize> {
     }
     out.reverse();
     out
+}
+
+/// Where potrace's `bestpolygon` searches, in indices relative to the
+/// start vertex (0, and `n` for it again).
+pub(super) struct Bounds {
+    /// `clip1[j]`: the nearest vertex a segment into `j` can start from
+    /// (nondecreasing).
+    pub(super) clip1: Vec<usize>,
+    /// `seg0[j]`: the farthest vertex `j` segments reach from 0.
+    pub(super) seg0: Vec<usize>,
+    /// `seg1[j]`: the nearest vertex from which `n` is reached in `m − j`
+    /// segments (`m = seg0.len() − 1`, the fewest segments).
+    pub(super) seg1: Vec<usize>,
+}
+
+impl Bounds {
+    /// The bounds of possible segments `ahead` (see [`possible_segments`])
+    /// from vertex `start`.
+    pub(super) fn new(ahead: &[usize], start: usize) -> Self {
+        let n = ahead.len();
+        // clip0[i]: the farthest vertex a segment from i reaches
+        // (nondecreasing).
+        let (before, after) = ahead.split_at(start.min(n));
+        let mut clip0 = Vec::with_capacity(n);
+        clip0.extend(after.iter().map(|&a| a.max(1)));
+        clip0.extend(before.iter().map(|&a| a.max(1)));
+        for (i, c) in clip0.iter_mut().enumerate() {
+            *c = (*c + i).min(n);
+        }
+        let mut clip1 = vec![0usize; n + 1];
+        let mut i = 0;
+        for (j, c) in clip1.iter_mut().enumerate().skip(1) {
+            while clip0.get(i).is_some_and(|&c0| c0 < j) {
+                i += 1;
+            }
+            *c = i;
+        }
+        let mut seg0 = vec![0usize];
+        let mut at = 0;
+        while at < n {
+            at = clip0.get(at).copied().unwrap_or(n);
+            seg0.push(at);
+        }
+        let m = seg0.len() - 1;
+        let mut seg1 = vec![0usize; m + 1];
+        seg1[m] = n;
+        for j in (1..=m).rev() {
+            seg1[j - 1] = clip1.get(seg1[j]).copied().unwrap_or(0);
+        }
+        Bounds { clip1, seg0, seg1 }
+    }
 }
 
 /// The best start `k` of the last segment into relative vertex `i`, of the

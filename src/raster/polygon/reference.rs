@@ -153,29 +153,8 @@ pub(super) fn optimal_polygon(path: &[Point], ahead: &[usize]) -> Vec<usize> {
     }
     let (start, _) = fewest_start(ahead);
     let sums = Sums::new(path, start);
-    let clip0: Vec<usize> = (0..n)
-        .map(|i| (i + ahead[(start + i) % n].max(1)).min(n))
-        .collect();
-    let mut clip1 = vec![0usize; n + 1];
-    let mut i = 0;
-    for (j, c) in clip1.iter_mut().enumerate().skip(1) {
-        while clip0.get(i).is_some_and(|&c0| c0 < j) {
-            i += 1;
-        }
-        *c = i;
-    }
-    let mut seg0 = vec![0usize];
-    let mut at = 0;
-    while at < n {
-        at = clip0[at];
-        seg0.push(at);
-    }
+    let super::Bounds { clip1, seg0, seg1 } = super::Bounds::new(ahead, start);
     let m = seg0.len() - 1;
-    let mut seg1 = vec![0usize; m + 1];
-    seg1[m] = n;
-    for j in (1..=m).rev() {
-        seg1[j - 1] = clip1[seg1[j]];
-    }
     let mut pen = vec![f64::INFINITY; n + 1];
     let mut prev = vec![0usize; n + 1];
     pen[0] = 0.0;
