@@ -563,3 +563,89 @@ fn specks_are_measured_in_pixels() {
     assert_eq!(traced(3.0), vec![1, 1, 2], "the L kept too");
     assert_eq!(traced(5.0), vec![1], "the square alone, hole filled");
 }
+
+/// Anti-aliased apexes stay points: half coverage cuts the apexes of a thin
+/// zigzag off (a flat, or a lopsided blunt end), and the tracer puts the
+/// point back (`raster::tips`). At every vertex of the drawn zigzags (16
+/// apexes turning by 140°, inside and out, 1 to 3 px lines) the traced
+/// outline has one node within 1.25 px that turns by more than 110° (a flat
+/// has two nodes turning by about 70°; the 1-px zigzag's inner apexes land
+/// a pixel deep, its sides read from coverage being a little off next to
+/// the apex).
+#[test]
+fn anti_aliased_apexes_stay_sharp() {
+    use kurbo::{PathEl, Vec2};
+    let turn = |a: Vec2, b: Vec2| a.cross(b).atan2(a.dot(b)).abs().to_degrees();
+    let png = root().join("samples/trace/thin-lines.png");
+    let doc = trace_file(&png, &InputOptions::default(), &TraceOptions::default()).expect("traces");
+    // Every node of the output with the tangents arriving and leaving.
+    let mut nodes: Vec<(kurbo::Point, f64)> = Vec::new();
+    for p in traced_subpaths(&doc) {
+        let segs: Vec<PathSeg> = p.segments().collect();
+        let n = segs.len();
+        let ends = |s: &PathSeg| -> (Vec2, Vec2) {
+            match *s {
+                PathSeg::Line(l) => (l.p1 - l.p0, l.p1 - l.p0),
+                PathSeg::Quad(q) => (q.p1 - q.p0, q.p2 - q.p1),
+                PathSeg::Cubic(c) => {
+                    let a = if (c.p1 - c.p0).hypot() > 1e-9 {
+                        c.p1 - c.p0
+                    } else {
+                        c.p2 - c.p0
+                    };
+                    let b = if (c.p3 - c.p2).hypot() > 1e-9 {
+                        c.p3 - c.p2
+                    } else {
+                        c.p3 - c.p1
+                    };
+                    (a, b)
+                }
+            }
+        };
+        for i in 0..n {
+            let arriving = ends(&segs[(i + n - 1) % n]).1;
+            let leaving = ends(&segs[i]).0;
+            nodes.push((segs[i].start(), turn(arriving, leaving)));
+        }
+    }
+    let mut apexes = 0;
+    for line in thin_lines_drawn() {
+        let pts: Vec<kurbo::Point> = line
+            .elements()
+            .iter()
+            .filter_map(|e| match *e {
+                PathEl::MoveTo(p) | PathEl::LineTo(p) => Some(p),
+                _ => None,
+            })
+            .collect();
+        let n = pts.len();
+        // The zigzags are polygons; the waves' outlines are curves, whose
+        // ends turn sharply between a cap and a control point.
+        if line
+            .elements()
+            .iter()
+            .any(|e| matches!(e, PathEl::CurveTo(..) | PathEl::QuadTo(..)))
+        {
+            continue;
+        }
+        for i in 0..n {
+            let (a, p, b) = (pts[(i + n - 1) % n], pts[i], pts[(i + 1) % n]);
+            if turn(p - a, b - p) <= 100.0 {
+                continue;
+            }
+            apexes += 1;
+            let near = nodes
+                .iter()
+                .filter(|(q, _)| (*q - p).hypot() <= 1.25)
+                .map(|&(_, t)| t)
+                .fold(0.0f64, f64::max);
+            assert!(
+                near > 110.0,
+                "apex at ({:.1}, {:.1}): sharpest node near it turns {near:.0}°",
+                p.x,
+                p.y
+            );
+        }
+    }
+    assert_eq!(apexes, 16, "the drawn zigzags' apexes");
+}

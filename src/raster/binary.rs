@@ -404,10 +404,12 @@ fn corner_mask(l: &SmoothLoop) -> Vec<bool> {
 }
 
 /// A closed polygon that follows an outline closely (an anti-aliased
-/// bitmap's sub-pixel outline) as a [`SmoothLoop`]: corners where it turns
-/// sharply within a pixel or so ([`crate::trace::corner::corners`]), chord
-/// tangents elsewhere.
+/// bitmap's sub-pixel outline) as a [`SmoothLoop`]: apexes that half
+/// coverage cut off given their points back (`super::tips`), corners where
+/// it turns sharply within a pixel or so ([`crate::trace::corner::corners`]),
+/// chord tangents elsewhere.
 pub fn polygon_loop(points: Vec<Point>) -> SmoothLoop {
+    let points = super::tips::sharpen(points);
     let corners = crate::trace::corner::corners(&points);
     let n = points.len();
     let tangents = (0..n)

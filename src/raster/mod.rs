@@ -14,6 +14,7 @@ pub mod plain;
 mod polygon;
 pub mod scan;
 pub mod sdf;
+mod tips;
 mod vertices;
 
 pub use sdf::Sdf;
