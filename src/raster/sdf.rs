@@ -430,6 +430,87 @@ fn thin_run(cov: &Coverage, x: i32, y: i32, dx: i32, dy: i32) -> Option<(i32, i3
     (last - first < THIN_RUN && !inked(last + 1) && !inked(first - 1)).then_some((first, last))
 }
 
+/// The thin run through every pixel along each pixel axis: what
+/// [`thin_run`] walks out from one pixel, found for all of them in one pass
+/// along the rows and one down the columns (the walk from every pixel of a
+/// 512² glyph was half of its trace).
+struct ThinRuns {
+    width: usize,
+    /// Per pixel: its run along x as steps `(first ≤ 0, last ≥ 0)`, if thin.
+    along_x: Vec<Option<(i8, i8)>>,
+    /// The same along y.
+    along_y: Vec<Option<(i8, i8)>>,
+}
+
+impl ThinRuns {
+    fn new(cov: &Coverage) -> Self {
+        let (w, h) = (cov.width(), cov.height());
+        let inked = |c: f32| c > COVERAGE_EPS;
+        // Every maximal run of inked pixels at most THIN_RUN long, given by
+        // its first index and length, marks each of its pixels.
+        let mark = |out: &mut dyn FnMut(usize, (i8, i8)), start: usize, len: usize| {
+            if len as i32 <= THIN_RUN {
+                for k in 0..len {
+                    out(start + k, (-(k as i8), (len - 1 - k) as i8));
+                }
+            }
+        };
+        let mut along_x = vec![None; w * h];
+        along_x
+            .par_chunks_mut(w.max(1))
+            .zip(cov.data().par_chunks(w.max(1)))
+            .for_each(|(out, row)| {
+                let mut start = None;
+                for x in 0..=w {
+                    let ink = row.get(x).is_some_and(|&c| inked(c));
+                    match (ink, start) {
+                        (true, None) => start = Some(x),
+                        (false, Some(s)) => {
+                            mark(&mut |i, r| out[i] = Some(r), s, x - s);
+                            start = None;
+                        }
+                        _ => {}
+                    }
+                }
+            });
+        // Columns: each column's open run carried down the rows.
+        let mut along_y = vec![None; w * h];
+        let mut start: Vec<Option<usize>> = vec![None; w];
+        for y in 0..=h {
+            for (x, st) in start.iter_mut().enumerate() {
+                let ink = y < h && inked(cov.get(x, y));
+                match (ink, *st) {
+                    (true, None) => *st = Some(y),
+                    (false, Some(s)) => {
+                        mark(&mut |j, r| along_y[j * w + x] = Some(r), s, y - s);
+                        *st = None;
+                    }
+                    _ => {}
+                }
+            }
+        }
+        ThinRuns {
+            width: w,
+            along_x,
+            along_y,
+        }
+    }
+
+    /// The thin run through pixel `(x, y)` along axis `(dx, dy)` (one of
+    /// `(1, 0)`, `(0, 1)`), as [`thin_run`] gives it.
+    fn get(&self, x: usize, y: usize, along_x: bool) -> Option<(i32, i32)> {
+        let runs = if along_x {
+            &self.along_x
+        } else {
+            &self.along_y
+        };
+        runs.get(y * self.width + x)
+            .copied()
+            .flatten()
+            .map(|(a, b)| (i32::from(a), i32::from(b)))
+    }
+}
+
 /// The ink (px) of the thin runs pixel `(x, y)` lies in (the most over
 /// the two pixel axes; a run of at most [`THIN_RUN`] inked pixels between
 /// paper), and whether it is a ridge: it carries a thin line no pixel of
@@ -439,24 +520,27 @@ fn thin_run(cov: &Coverage, x: i32, y: i32, dx: i32, dy: i32) -> Option<(i32, i3
 /// half it vanishes, and a wave drawn with it breaks at every trough. A
 /// ridge counts as ink, and [`thin_run_crossing`] then places the line's
 /// edges by its run's ink.
-fn thin_mass(cov: &Coverage, x: i32, y: i32) -> (f32, bool) {
+fn thin_mass(cov: &Coverage, runs: &ThinRuns, x: usize, y: usize) -> (f32, bool) {
     let (mut best, mut ridge) = (0.0f32, false);
-    for (dx, dy) in [(1, 0), (0, 1)] {
-        let Some((first, last)) = thin_run(cov, x, y, dx, dy) else {
+    for (along_x, (dx, dy)) in [(true, (1, 0)), (false, (0, 1))] {
+        let Some((first, last)) = runs.get(x, y, along_x) else {
             continue;
         };
-        let run: Vec<f32> = (first..=last)
-            .map(|j| coverage_at(cov, x + j * dx, y + j * dy))
-            .collect();
-        let most = run.iter().copied().fold(0.0f32, f32::max);
-        let mass: f32 = run.iter().sum();
+        let at = |j: i32| coverage_at(cov, x as i32 + j * dx, y as i32 + j * dy);
+        // In order along the run, as the sum and the first maximum are
+        // defined.
+        let (mut most, mut mass, mut first_most) = (f32::NEG_INFINITY, 0.0f32, first);
+        for j in first..=last {
+            let c = at(j);
+            mass += c;
+            if c > most {
+                most = c;
+                first_most = j;
+            }
+        }
         best = best.max(mass);
         // This pixel is the first of the most covered.
-        let first_most = run
-            .iter()
-            .position(|&v| v == most)
-            .map(|k| k as i32 + first);
-        ridge |= most < 0.5 && mass >= 0.5 && first_most == Some(0);
+        ridge |= most < 0.5 && mass >= 0.5 && first_most == 0;
     }
     (best, ridge)
 }
@@ -481,19 +565,28 @@ fn outline_polygons(cov: &Coverage, thin_runs: bool) -> (Grid<bool>, Vec<Vec<Poi
     // thin runs, a pixel of a thin line counts as covered by its run's
     // whole ink (so a ridge pixel is inside, and the two pixels of a
     // diagonal step of a hairline join at their saddle).
-    let values = Grid::from_fn(cov.width(), cov.height(), |x, y| {
-        let c = cov.get(x, y);
-        let (mass, ridge) = if thin_runs {
-            thin_mass(cov, x as i32, y as i32)
-        } else {
-            (0.0, false)
-        };
-        if c >= 0.5 || ridge {
-            -(c.max(mass) - 0.5).max(1e-6)
-        } else {
-            0.5 - c
-        }
-    });
+    let runs = thin_runs.then(|| ThinRuns::new(cov));
+    let w = cov.width();
+    let mut values = vec![0.0f32; w * cov.height()];
+    values
+        .par_chunks_mut(w.max(1))
+        .zip(cov.data().par_chunks(w.max(1)))
+        .enumerate()
+        .for_each(|(y, (row, cov_row))| {
+            for (x, (v, &c)) in row.iter_mut().zip(cov_row).enumerate() {
+                let (mass, ridge) = match &runs {
+                    Some(r) if c > COVERAGE_EPS => thin_mass(cov, r, x, y),
+                    _ => (0.0, false),
+                };
+                *v = if c >= 0.5 || ridge {
+                    -(c.max(mass) - 0.5).max(1e-6)
+                } else {
+                    0.5 - c
+                };
+            }
+        });
+    let values =
+        Grid::from_vec(w, cov.height(), values).unwrap_or_else(|| Grid::new(w, cov.height(), 0.0));
     let inside = values.map(|v| v < 0.0);
     let thin = thin_runs.then_some(&inside);
     let contours = contour::extract(&values);
@@ -533,6 +626,43 @@ fn outline_polygons(cov: &Coverage, thin_runs: bool) -> (Grid<bool>, Vec<Vec<Poi
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The runs found in one pass per axis are the runs walked out from
+    /// each pixel, on random grids of sparse strokes (runs of every length
+    /// up to past [`THIN_RUN`], touching the grid's edges).
+    #[test]
+    fn thin_runs_match_the_walk_from_each_pixel() {
+        let mut state = 99u64;
+        let mut rnd = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 33) as f64 / (1u64 << 31) as f64
+        };
+        for trial in 0..40 {
+            let (w, h) = (1 + trial % 13, 1 + (trial * 7) % 11);
+            let density = 0.2 + 0.6 * rnd();
+            let cov = Grid::from_fn(w, h, |_, _| {
+                if rnd() < density {
+                    (rnd() as f32).max(0.01)
+                } else {
+                    0.0
+                }
+            });
+            let runs = ThinRuns::new(&cov);
+            for y in 0..h {
+                for x in 0..w {
+                    for (along_x, (dx, dy)) in [(true, (1, 0)), (false, (0, 1))] {
+                        assert_eq!(
+                            runs.get(x, y, along_x),
+                            thin_run(&cov, x as i32, y as i32, dx, dy),
+                            "{w}x{h} pixel ({x}, {y}) along x: {along_x}"
+                        );
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn clip_line_keeps_exactly_the_part_inside() {
