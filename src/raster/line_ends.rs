@@ -234,8 +234,9 @@ const MITRE_TURN: (f64, f64) = (60.0, 150.0);
 /// wide in the bitmap, so the polygon has a short edge there between two
 /// vertices that each turn by half the angle; potrace's corner measure
 /// reads both as smooth and the apex comes out as a round blob. The two
-/// vertices become the point where their long neighbouring edges meet
-/// (the turn's mitre), kept as a corner. `keep` marks the corners of
+/// vertices become the point where the polygon's arms either side meet
+/// (the turn's mitre: [`arm`], the straight run of edges beyond the
+/// neighbouring edge), kept as a corner. `keep` marks the corners of
 /// [`square_line_ends`]' caps, which are left alone; it is returned
 /// updated.
 pub(super) fn mitre_short_edges(v: Vec<Point>, keep: Vec<bool>) -> (Vec<Point>, Vec<bool>) {
@@ -257,26 +258,43 @@ pub(super) fn mitre_short_edges(v: Vec<Point>, keep: Vec<bool>) -> (Vec<Point>, 
         if used[i] || used[j] || keep[i] || keep[j] {
             continue;
         }
-        let (a, p, q, b) = (v[(i + k - 1) % k], v[i], v[j], v[(i + 2) % k]);
-        let (d0, e, d1) = (p - a, q - p, b - q);
-        let short = e.hypot();
-        let side = d0.hypot().min(d1.hypot());
-        if short > MITRE_EDGE || side < MIN_SIDE.max(2.0 * short) {
+        let (p, q) = (v[i], v[j]);
+        if (q - p).hypot() > MITRE_EDGE {
             continue;
         }
-        // Both vertices turn the same way, by a sharp turn in all, and the
-        // turning is gathered here (not spread along a curve).
-        let (t0, t1) = (d0.cross(e), e.cross(d1));
-        let signed = turn_deg(a, p, b + (p - q));
-        let turn = signed.abs();
-        if t0 * t1 <= 0.0
-            || turn < MITRE_TURN.0
-            || turn > MITRE_TURN.1
-            || spread(signed, [turn_at((i + k - 1) % k), turn_at((i + 2) % k)])
-        {
+        // A mitre when the neighbouring edges are long enough, and both
+        // vertices turn the same way, by a sharp turn in all, with the
+        // turning gathered here (not spread along a curve): `t0` is the
+        // first vertex's turn (its sign says convex or concave).
+        let mitres = |a: Point, b: Point| -> Option<f64> {
+            let (d0, e, d1) = (p - a, q - p, b - q);
+            let side = d0.hypot().min(d1.hypot());
+            let (t0, t1) = (d0.cross(e), e.cross(d1));
+            let signed = turn_deg(a, p, b + (p - q));
+            let turn = signed.abs();
+            let ok = side >= MIN_SIDE.max(2.0 * e.hypot())
+                && t0 * t1 > 0.0
+                && (MITRE_TURN.0..=MITRE_TURN.1).contains(&turn)
+                && !spread(signed, [turn_at((i + k - 1) % k), turn_at((i + 2) % k)]);
+            ok.then_some(t0)
+        };
+        // Measured on the neighbouring edges; failing that, at a thin
+        // line's apex, on the arms beyond them: next to the apex the
+        // staircase shortens the neighbouring edges to a pixel or two and
+        // bends them over (the 1-px zigzag's top turns by 153° over them,
+        // drawn at 140°).
+        let (a, b) = (v[(i + k - 1) % k], v[(i + 2) % k]);
+        let arms = (arm(&v, i, false), arm(&v, j, true));
+        let thin = turn_deg(a, p, b + (p - q)).abs() > THIN_APEX;
+        let Some(t0) = mitres(a, b).or_else(|| thin.then(|| mitres(arms.0, arms.1)).flatten())
+        else {
             continue;
-        }
-        // Where the lines a → p and q → b meet.
+        };
+        // Where the arms' lines meet: next to a thin line's apex the
+        // neighbouring edges are a pixel or two long, as its staircase
+        // steps, and point up to 20° off the line (the 2-px zigzag's notch
+        // came out 1.27 px deeper than drawn, 0.94 px along the arms).
+        let (d0, d1) = (p - arms.0, arms.1 - q);
         let det = d0.cross(d1);
         if det.abs() < 1e-9 {
             continue;
@@ -301,17 +319,19 @@ pub(super) fn mitre_short_edges(v: Vec<Point>, keep: Vec<bool>) -> (Vec<Point>, 
         used[(i + k - 1) % k] = true;
         used[(i + 2) % k] = true;
     }
-    // A single vertex at such a turn between long edges is a mitre already:
+    // A single vertex at such a turn between long arms is a mitre already:
     // kept a corner (the corner measure reads a 1-px zigzag's apex, whose
     // neighbouring vertices sit a few pixels down the arms, as smooth),
-    // unless the turning is spread along a curve.
+    // unless the turning is spread along a curve. The arms, not the
+    // neighbouring edges, are measured: next to the apex the staircase may
+    // put a vertex 2.7 px down one arm, which goes on straight.
     for i in 0..k {
-        let (a, p, b) = (v[(i + k - 1) % k], v[i], v[(i + 1) % k]);
-        let (d0, d1) = (p - a, b - p);
+        let p = v[i];
+        let (a, b) = (arm(&v, i, false), arm(&v, i, true));
         let signed = turn_at(i);
         let turn = signed.abs();
         if !used[i]
-            && d0.hypot().min(d1.hypot()) >= MIN_SIDE
+            && (p - a).hypot().min((b - p).hypot()) >= MIN_SIDE
             && turn >= MITRE_TURN.0
             && turn <= MITRE_TURN.1
             && !spread(signed, [turn_at((i + k - 1) % k), turn_at((i + 1) % k)])
@@ -347,6 +367,45 @@ pub(super) fn mitre_short_edges(v: Vec<Point>, keep: Vec<bool>) -> (Vec<Point>, 
         }
     }
     (out, corner)
+}
+
+/// Turn (degrees) over a short edge from which it is read as a thin
+/// line's apex, and measured along the arms either side ([`arm`]) rather
+/// than its neighbouring edges, which the staircase next to the apex
+/// shortens to a pixel or two and bends by up to 20°.
+const THIN_APEX: f64 = 120.0;
+
+/// Largest turn (degrees) at a vertex that an arm goes straight on over.
+const ARM_TURN: f64 = 20.0;
+
+/// Length (px) after which an arm stops.
+const ARM_LENGTH: f64 = 12.0;
+
+/// The far end of the arm of polygon `v` from vertex `i`, backwards or
+/// forwards: the vertices on from `i` while the polygon goes on about
+/// straight (turning under [`ARM_TURN`] at each), until the arm is
+/// [`ARM_LENGTH`] long.
+fn arm(v: &[Point], i: usize, forwards: bool) -> Point {
+    let k = v.len();
+    let step = |j: usize| {
+        if forwards {
+            (j + 1) % k
+        } else {
+            (j + k - 1) % k
+        }
+    };
+    let mut j = step(i);
+    let mut len = (v[j] - v[i]).hypot();
+    for _ in 0..k {
+        let n = step(j);
+        let t = turn_deg(v[(j + k - 1) % k], v[j], v[(j + 1) % k]);
+        if t.abs() >= ARM_TURN || len >= ARM_LENGTH || n == i {
+            break;
+        }
+        len += (v[n] - v[j]).hypot();
+        j = n;
+    }
+    v[j]
 }
 
 /// The signed turn (degrees, counter-clockwise positive in the y-up sense
@@ -512,11 +571,23 @@ mod tests {
     }
 
     /// A 1-px zigzag's apex (sides of slope ±2.5, as on the thin-lines
-    /// sample) comes out as a mitre: a corner at the outer apex, the outline never more than [`super::MITRE_OUT`]
-    /// (plus the pixel's own half) beyond the ink.
+    /// sample) comes out as a mitre wherever it falls on the pixel grid: a
+    /// corner at the outer apex, the outline never more than
+    /// [`super::MITRE_OUT`] (plus the pixel's own half) beyond the ink. (At
+    /// some offsets the pixels next to the apex bend its neighbouring
+    /// edges over to a U-turn of 153°, and the apex came out a round blob
+    /// before the mitre read the arms beyond them, [`super::arm`].)
     #[test]
     fn a_thin_zigzag_apex_is_mitred() {
-        let apex = Point::new(20.3, 6.0);
+        for k in 0..16 {
+            thin_zigzag_apex(Point::new(
+                20.0 + k as f64 / 16.0,
+                6.0 + (k % 4) as f64 / 4.0,
+            ));
+        }
+    }
+
+    fn thin_zigzag_apex(apex: Point) {
         let cov: Coverage = Grid::from_fn(42, 40, |x, y| {
             let (px, py) = (x as f64 + 0.5, y as f64 + 0.5);
             let dy = py - apex.y;
@@ -537,8 +608,8 @@ mod tests {
             .map(|&c| l.points[c])
             .filter(|p| (p.x - apex.x).abs() < 3.0 && p.y < apex.y + 5.0)
             .collect();
-        assert!(!near_apex.is_empty(), "no corner at the apex");
-        let ink = |x: f64, y: f64| cov.get(x as usize, y as usize) > 0.5;
+        assert!(!near_apex.is_empty(), "apex at {apex:?}: no corner");
+        let ink = |x: f64, y: f64| cov.get_or(x as isize, y as isize, 0.0) > 0.5;
         for p in &l.points {
             // The nearest ink pixel, searched within 3 px.
             let mut d = f64::INFINITY;
@@ -554,7 +625,7 @@ mod tests {
             }
             assert!(
                 d <= super::MITRE_OUT + 0.5,
-                "{p:?} is {d:.2} px off the ink"
+                "apex at {apex:?}: {p:?} is {d:.2} px off the ink"
             );
         }
     }
