@@ -284,10 +284,13 @@ pub(super) fn mitre_short_edges(v: Vec<Point>, keep: Vec<bool>) -> (Vec<Point>, 
         // bends them over (the 1-px zigzag's top turns by 153° over them,
         // drawn at 140°).
         let (a, b) = (v[(i + k - 1) % k], v[(i + 2) % k]);
-        let arms = (arm(&v, i, false), arm(&v, j, true));
         let thin = turn_deg(a, p, b + (p - q)).abs() > THIN_APEX;
-        let Some(t0) = mitres(a, b).or_else(|| thin.then(|| mitres(arms.0, arms.1)).flatten())
-        else {
+        let near = mitres(a, b);
+        if near.is_none() && !thin {
+            continue;
+        }
+        let arms = (arm(&v, i, false), arm(&v, j, true));
+        let Some(t0) = near.or_else(|| mitres(arms.0, arms.1)) else {
             continue;
         };
         // Where the arms' lines meet: next to a thin line's apex the
@@ -326,17 +329,16 @@ pub(super) fn mitre_short_edges(v: Vec<Point>, keep: Vec<bool>) -> (Vec<Point>, 
     // neighbouring edges, are measured: next to the apex the staircase may
     // put a vertex 2.7 px down one arm, which goes on straight.
     for i in 0..k {
-        let p = v[i];
-        let (a, b) = (arm(&v, i, false), arm(&v, i, true));
         let signed = turn_at(i);
         let turn = signed.abs();
         if !used[i]
-            && (p - a).hypot().min((b - p).hypot()) >= MIN_SIDE
             && turn >= MITRE_TURN.0
             && turn <= MITRE_TURN.1
             && !spread(signed, [turn_at((i + k - 1) % k), turn_at((i + 1) % k)])
         {
-            bevel[i] = true;
+            let p = v[i];
+            let (a, b) = (arm(&v, i, false), arm(&v, i, true));
+            bevel[i] = (p - a).hypot().min((b - p).hypot()) >= MIN_SIDE;
         }
     }
     if merged.iter().all(Option::is_none) {
