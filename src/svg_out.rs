@@ -272,17 +272,23 @@ pub fn fmt_num(v: f64, decimals: u32) -> String {
 
 /// Formats the integer `q` as a decimal with `decimals` implied decimals.
 fn fmt_fixed(q: i64, decimals: u32) -> String {
-    let neg = q < 0;
+    let mut s = String::new();
+    push_fixed(&mut s, q, decimals);
+    s
+}
+
+/// Appends `q / 10^decimals` to `out` in the compact form of [`fmt_fixed`],
+/// writing the digits straight into `out` (no intermediate `String`).
+fn push_fixed(out: &mut String, q: i64, decimals: u32) {
     let a = q.unsigned_abs();
     let scale = 10u64.pow(decimals);
     let int = a / scale;
     let mut frac = a % scale;
-    let mut s = String::new();
-    if neg && a != 0 {
-        s.push('-');
+    if q < 0 && a != 0 {
+        out.push('-');
     }
     if int != 0 || frac == 0 {
-        let _ = write!(s, "{int}");
+        push_digits(out, int, 1);
     }
     if frac != 0 {
         let mut digits = decimals as usize;
@@ -290,9 +296,26 @@ fn fmt_fixed(q: i64, decimals: u32) -> String {
             frac /= 10;
             digits -= 1;
         }
-        let _ = write!(s, ".{frac:0digits$}");
+        out.push('.');
+        push_digits(out, frac, digits);
     }
-    s
+}
+
+/// Appends the decimal digits of `v` to `out`, left-padded with zeros to at
+/// least `min_digits` digits.
+fn push_digits(out: &mut String, mut v: u64, min_digits: usize) {
+    let mut buf = [b'0'; 20];
+    let mut n = 0;
+    while (v != 0 || n < min_digits) && n < buf.len() {
+        if let Some(b) = buf.get_mut(n) {
+            *b = b'0' + (v % 10) as u8;
+        }
+        v /= 10;
+        n += 1;
+    }
+    for &b in buf.iter().take(n).rev() {
+        out.push(char::from(b));
+    }
 }
 
 /// Appends numbers to path data with the fewest separators SVG allows.
@@ -322,17 +345,23 @@ impl DataWriter {
     }
 
     fn num(&mut self, q: i64) {
-        let s = fmt_fixed(q, self.decimals);
-        let needs_sep = match self.out.chars().last() {
+        // The text's first character and whether it has a dot follow from
+        // the value alone (see `push_fixed`), so no intermediate string.
+        let a = q.unsigned_abs();
+        let scale = 10u64.pow(self.decimals);
+        let has_dot = !a.is_multiple_of(scale);
+        let starts_minus = q < 0;
+        let starts_dot = !starts_minus && a < scale && has_dot;
+        let needs_sep = match self.out.as_bytes().last() {
             None => false,
             Some(ch) if ch.is_ascii_alphabetic() => false,
-            Some(_) => !(s.starts_with('-') || (s.starts_with('.') && self.last_has_dot)),
+            Some(_) => !(starts_minus || (starts_dot && self.last_has_dot)),
         };
         if needs_sep {
             self.out.push(' ');
         }
-        self.last_has_dot = s.contains('.');
-        self.out.push_str(&s);
+        self.last_has_dot = has_dot;
+        push_fixed(&mut self.out, q, self.decimals);
     }
 }
 
