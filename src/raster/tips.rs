@@ -60,15 +60,9 @@ struct Arc<'a> {
 
 impl<'a> Arc<'a> {
     fn new(pts: &'a [Point]) -> Self {
-        let n = pts.len();
-        let mut cum = Vec::with_capacity(n + 1);
-        let mut s = 0.0;
-        cum.push(0.0);
-        for i in 0..n {
-            s += (pts[(i + 1) % n] - pts[i]).hypot();
-            cum.push(s);
-        }
-        Arc { pts, cum, total: s }
+        let cum = crate::trace::contour::closed_arc_lengths(pts);
+        let total = cum.last().copied().unwrap_or(0.0);
+        Arc { pts, cum, total }
     }
 
     /// The point at arc length `s` (wrapping round the loop).

@@ -76,6 +76,20 @@ impl Contour {
     }
 }
 
+/// Cumulative arc lengths (px) round a closed polygon: `cum[i]` to vertex
+/// `i`, `cum[n]` the whole loop (the closing edge included).
+pub fn closed_arc_lengths(points: &[Point]) -> Vec<f64> {
+    let n = points.len();
+    let mut cum = Vec::with_capacity(n + 1);
+    let mut s = 0.0;
+    cum.push(0.0);
+    for i in 0..n {
+        s += (points[(i + 1) % n] - points[i]).hypot();
+        cum.push(s);
+    }
+    cum
+}
+
 /// Shoelace signed area of a closed polygon.
 pub fn signed_area(points: &[Point]) -> f64 {
     let n = points.len();

@@ -24,14 +24,8 @@ pub fn corners(pts: &[Point]) -> Vec<usize> {
     if n < 4 {
         return Vec::new();
     }
-    let mut cum = Vec::with_capacity(n + 1);
-    let mut s = 0.0;
-    cum.push(0.0);
-    for i in 0..n {
-        s += (pts[(i + 1) % n] - pts[i]).hypot();
-        cum.push(s);
-    }
-    let total = s;
+    let cum = super::contour::closed_arc_lengths(pts);
+    let total = cum[n];
     if total < 4.0 * CORNER_WINDOW {
         return Vec::new();
     }
