@@ -273,15 +273,15 @@ pub fn fmt_num(v: f64, decimals: u32) -> String {
 /// Formats the integer `q` as a decimal with `decimals` implied decimals.
 fn fmt_fixed(q: i64, decimals: u32) -> String {
     let mut s = String::new();
-    push_fixed(&mut s, q, decimals);
+    push_fixed(&mut s, q, decimals, 10u64.pow(decimals));
     s
 }
 
 /// Appends `q / 10^decimals` to `out` in the compact form of [`fmt_fixed`],
-/// writing the digits straight into `out` (no intermediate `String`).
-fn push_fixed(out: &mut String, q: i64, decimals: u32) {
+/// writing the digits straight into `out` (no intermediate `String`);
+/// `scale` is `10^decimals`.
+fn push_fixed(out: &mut String, q: i64, decimals: u32, scale: u64) {
     let a = q.unsigned_abs();
-    let scale = 10u64.pow(decimals);
     let int = a / scale;
     let mut frac = a % scale;
     if q < 0 && a != 0 {
@@ -324,6 +324,8 @@ struct DataWriter {
     last_cmd: Option<char>,
     last_has_dot: bool,
     decimals: u32,
+    /// `10^decimals`: one unit of the written numbers' last digit.
+    scale: u64,
 }
 
 impl DataWriter {
@@ -348,10 +350,9 @@ impl DataWriter {
         // The text's first character and whether it has a dot follow from
         // the value alone (see `push_fixed`), so no intermediate string.
         let a = q.unsigned_abs();
-        let scale = 10u64.pow(self.decimals);
-        let has_dot = !a.is_multiple_of(scale);
+        let has_dot = !a.is_multiple_of(self.scale);
         let starts_minus = q < 0;
-        let starts_dot = !starts_minus && a < scale && has_dot;
+        let starts_dot = !starts_minus && a < self.scale && has_dot;
         let needs_sep = match self.out.as_bytes().last() {
             None => false,
             Some(ch) if ch.is_ascii_alphabetic() => false,
@@ -361,7 +362,7 @@ impl DataWriter {
             self.out.push(' ');
         }
         self.last_has_dot = has_dot;
-        push_fixed(&mut self.out, q, self.decimals);
+        push_fixed(&mut self.out, q, self.decimals, self.scale);
     }
 }
 
@@ -377,6 +378,7 @@ pub fn path_data(path: &BezPath, decimals: u32) -> String {
         last_cmd: None,
         last_has_dot: false,
         decimals,
+        scale: 10u64.pow(decimals),
     };
     let mut cur = (0i64, 0i64);
     let mut start = (0i64, 0i64);

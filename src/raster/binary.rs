@@ -216,7 +216,8 @@ fn smooth_polygon(v: &[Point], keep: &[bool]) -> SmoothLoop {
             let alpha = alpha.clamp(0.55, 1.0);
             let c = CubicBez::new(m1, m1 + (p - m1) * alpha, m2 + (p - m2) * alpha, m2);
             let steps = cubic_steps(&c);
-            let (c1, c2) = (c.deriv(), c.deriv().deriv());
+            let c1 = c.deriv();
+            let c2 = c1.deriv();
             let h = 1.0 / steps as f64;
             for s in 0..steps {
                 let t = s as f64 / steps as f64;

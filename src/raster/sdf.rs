@@ -332,14 +332,14 @@ fn edge_model(cov: &Coverage, x: i32, y: i32) -> Option<EdgeModel> {
 /// Where the outline crosses link `l` (first end inside, or second end
 /// inside), as a fraction from its first end, and whether coverage informed
 /// the estimate.
-fn link_crossing(cov: &Coverage, l: Link, thin: Option<&Grid<bool>>) -> (f64, bool) {
+fn link_crossing(cov: &Coverage, l: Link, thin: Option<(&Grid<bool>, &ThinRuns)>) -> (f64, bool) {
     let ((x0, y0), (x1, y1)) = l.ends();
     let (w, h) = (cov.width() as i32, cov.height() as i32);
     let off = |x: i32, y: i32| x < 0 || y < 0 || x >= w || y >= h;
     if off(x0, y0) || off(x1, y1) {
         return (0.5, true);
     }
-    if let Some(t) = thin.and_then(|inside| thin_run_crossing(cov, inside, l)) {
+    if let Some(t) = thin.and_then(|(inside, runs)| thin_run_crossing(cov, inside, runs, l)) {
         return (clamp_t(t), true);
     }
     let e = l.direction();
@@ -385,13 +385,17 @@ const THIN_RUN: i32 = 3;
 /// interval reaches: `[first + ½ − c_first, last − ½ + c_last]`, so the
 /// interval holds exactly the run's ink. Returns the fraction of the link
 /// from its first end, or `None` when the link is not across a thin run.
-fn thin_run_crossing(cov: &Coverage, inside: &Grid<bool>, l: Link) -> Option<f64> {
+fn thin_run_crossing(cov: &Coverage, inside: &Grid<bool>, runs: &ThinRuns, l: Link) -> Option<f64> {
     let ((x0, y0), (x1, y1)) = l.ends();
     let (dx, dy) = if l.horizontal { (1, 0) } else { (0, 1) };
     // The run through the inside end; steps counted from the first end.
     let in0 = inside.get_or(x0 as isize, y0 as isize, false);
     let (x, y, shift) = if in0 { (x0, y0, 0) } else { (x1, y1, 1) };
-    let (first, last) = thin_run(cov, x, y, dx, dy)?;
+    let (first, last) = runs.get(
+        usize::try_from(x).ok()?,
+        usize::try_from(y).ok()?,
+        l.horizontal,
+    )?;
     let c_first = f64::from(coverage_at(cov, x + first * dx, y + first * dy));
     let c_last = f64::from(coverage_at(cov, x + last * dx, y + last * dy));
     let (first, last) = (f64::from(first + shift), f64::from(last + shift));
@@ -415,6 +419,7 @@ fn coverage_at(cov: &Coverage, x: i32, y: i32) -> f32 {
 /// `(x, y)`, as steps from it `(first ≤ 0, last ≥ 0)`, when it is thin: at
 /// most [`THIN_RUN`] pixels, paper (or the outside of the grid) at both
 /// ends.
+#[cfg(test)]
 fn thin_run(cov: &Coverage, x: i32, y: i32, dx: i32, dy: i32) -> Option<(i32, i32)> {
     let inked = |j: i32| coverage_at(cov, x + j * dx, y + j * dy) > COVERAGE_EPS;
     if !inked(0) {
@@ -430,10 +435,11 @@ fn thin_run(cov: &Coverage, x: i32, y: i32, dx: i32, dy: i32) -> Option<(i32, i3
     (last - first < THIN_RUN && !inked(last + 1) && !inked(first - 1)).then_some((first, last))
 }
 
-/// The thin run through every pixel along each pixel axis: what
-/// [`thin_run`] walks out from one pixel, found for all of them in one pass
-/// along the rows and one down the columns (the walk from every pixel of a
-/// 512² glyph was half of its trace).
+/// The thin run through every pixel along each pixel axis (a run of at
+/// most [`THIN_RUN`] inked pixels, paper or the grid's outside at both
+/// ends), found for all pixels in one pass along the rows and one down the
+/// columns: walking it out from every pixel was half the trace of a 512²
+/// glyph. The walk is kept as the tests' oracle.
 struct ThinRuns {
     width: usize,
     /// Per pixel: its run along x as steps `(first ≤ 0, last ≥ 0)`, if thin.
@@ -496,8 +502,8 @@ impl ThinRuns {
         }
     }
 
-    /// The thin run through pixel `(x, y)` along axis `(dx, dy)` (one of
-    /// `(1, 0)`, `(0, 1)`), as [`thin_run`] gives it.
+    /// The thin run through pixel `(x, y)` along x (`along_x`) or y, as
+    /// steps from it `(first ≤ 0, last ≥ 0)`.
     fn get(&self, x: usize, y: usize, along_x: bool) -> Option<(i32, i32)> {
         let runs = if along_x {
             &self.along_x
@@ -588,7 +594,7 @@ fn outline_polygons(cov: &Coverage, thin_runs: bool) -> (Grid<bool>, Vec<Vec<Poi
     let values =
         Grid::from_vec(w, cov.height(), values).unwrap_or_else(|| Grid::new(w, cov.height(), 0.0));
     let inside = values.map(|v| v < 0.0);
-    let thin = thin_runs.then_some(&inside);
+    let thin = runs.as_ref().map(|r| (&inside, r));
     let contours = contour::extract(&values);
     let polygons = contours
         .par_iter()
