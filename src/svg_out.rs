@@ -307,9 +307,7 @@ fn push_digits(out: &mut String, mut v: u64, min_digits: usize) {
     let mut buf = [b'0'; 20];
     let mut n = 0;
     while (v != 0 || n < min_digits) && n < buf.len() {
-        if let Some(b) = buf.get_mut(n) {
-            *b = b'0' + (v % 10) as u8;
-        }
+        buf[n] = b'0' + (v % 10) as u8;
         v /= 10;
         n += 1;
     }
