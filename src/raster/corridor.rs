@@ -16,52 +16,53 @@
 //! mixed cell lies within the tolerance of it.
 
 use super::paths::Bitmap;
-use super::{Coverage, Grid};
+use super::Coverage;
 use kurbo::Point;
-use rayon::prelude::*;
+use std::borrow::Cow;
 
-/// The mixed cells of a binary bitmap (see the module docs).
+/// The mixed cells of a binary bitmap (see the module docs), read from the
+/// bitmap's padded flags when asked ([`Corridor::reaches`] looks at a few
+/// cells per curve point, far fewer than the bitmap's cells, so no grid of
+/// them is built).
 #[derive(Clone, Debug)]
-pub struct Corridor {
-    /// `mixed[(i + 1, j + 1)]`: whether the cell between the centres of
-    /// pixels (i, j) and (i + 1, j + 1) has centres of both colours
-    /// (pixels outside the bitmap are paper); i, j from −1.
-    mixed: Grid<bool>,
+pub struct Corridor<'a> {
+    /// The ink flags, borrowed from the tracer's bitmap or owned.
+    bits: Cow<'a, Bitmap>,
 }
 
-impl Corridor {
+impl Corridor<'static> {
+    /// The corridor of binary coverage `cov` (ink where coverage ≥ ½).
+    pub fn new(cov: &Coverage) -> Self {
+        Corridor {
+            bits: Cow::Owned(Bitmap::from_coverage(cov)),
+        }
+    }
+}
+
+impl<'a> Corridor<'a> {
     /// How far (px) the corridor reaches to either side of the staircase
     /// along the pixel axes: half a pixel, the whole uncertainty of a
     /// binary edge.
     pub const HALF_WIDTH: f64 = 0.5;
 
-    /// The corridor of binary coverage `cov` (ink where coverage ≥ ½).
-    pub fn new(cov: &Coverage) -> Self {
-        Self::from_bitmap(&Bitmap::from_coverage(cov))
+    /// The corridor of a bitmap's ink.
+    pub fn from_bitmap(bits: &'a Bitmap) -> Self {
+        Corridor {
+            bits: Cow::Borrowed(bits),
+        }
     }
 
-    /// The corridor of a bitmap's ink.
-    pub fn from_bitmap(bits: &Bitmap) -> Self {
-        let (w, h) = (bits.width(), bits.height());
-        // Padded row y + 1 holds pixel row y between two paper flags, so
-        // cell (ci, cj) has the padded corners (ci, cj) to (ci + 1, cj + 1).
-        // Rows of cells in parallel (a 2 Mpx bitmap has 2 M cells), each
-        // from its two padded rows of flags.
-        let rows: Vec<&[u8]> = bits.padded_rows().collect();
-        let mut mixed = vec![false; (w + 1) * (h + 1)];
-        mixed
-            .par_chunks_mut(w + 1)
-            .zip(rows.par_windows(2))
-            .for_each(|(out, pair)| {
-                let (top, bottom) = (pair[0], pair[1]);
-                let (top1, bottom1) = (top.get(1..).unwrap_or(&[]), bottom.get(1..).unwrap_or(&[]));
-                let cells = top.iter().zip(top1).zip(bottom.iter().zip(bottom1));
-                for (o, ((&a, &b), (&c, &d))) in out.iter_mut().zip(cells) {
-                    *o = a != b || a != c || a != d;
-                }
-            });
-        let mixed = Grid::from_vec(w + 1, h + 1, mixed).unwrap_or_else(|| Grid::new(0, 0, false));
-        Corridor { mixed }
+    /// Whether the cell between the centres of pixels (ci − 1, cj − 1) and
+    /// (ci, cj) has centres of both colours (pixels outside the bitmap are
+    /// paper): its corners are padded flags (ci, cj) to (ci + 1, cj + 1).
+    fn mixed(&self, ci: usize, cj: usize) -> bool {
+        let pw = self.bits.width() + 2;
+        let f = self.bits.flags();
+        let i = cj * pw + ci;
+        match (f.get(i), f.get(i + 1), f.get(i + pw), f.get(i + pw + 1)) {
+            (Some(&a), Some(&b), Some(&c), Some(&d)) => (a | b | c | d) != (a & b & c & d),
+            _ => false,
+        }
     }
 
     /// How close (px) the edge may come to a pixel centre: it passes
@@ -85,12 +86,15 @@ impl Corridor {
         }
         // Cell (ci, cj) spans x from ci − ½ to ci + ½ (centres of pixels
         // ci − 1 and ci), likewise y.
-        let (w, h) = (self.mixed.width() as isize, self.mixed.height() as isize);
+        let (w, h) = (
+            self.bits.width() as isize + 1,
+            self.bits.height() as isize + 1,
+        );
         let lo = |v: f64| (v - reach + 0.5).floor() as isize;
         let hi = |v: f64| (v + reach + 0.5).floor() as isize;
         for cj in lo(p.y).max(0)..=hi(p.y).min(h - 1) {
             for ci in lo(p.x).max(0)..=hi(p.x).min(w - 1) {
-                if !self.mixed.get(ci as usize, cj as usize) {
+                if !self.mixed(ci as usize, cj as usize) {
                     continue;
                 }
                 let x0 = ci as f64 - 0.5;
@@ -109,6 +113,7 @@ impl Corridor {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::raster::Grid;
 
     /// Brute force: the distance from `p` to the nearest mixed cell, from
     /// pixel centres directly (infinite within the keep-out of a centre,

@@ -167,24 +167,39 @@ fn grey_coverage(grey: &image::GrayImage, invert: bool) -> RasterCoverage {
     });
     let raw = grey.as_raw();
     let raw = raw.get(..w * h).unwrap_or(raw);
-    // One pass over the bytes (in parallel; integer sums, so in any order):
-    // whether every level present has coverage exactly 0 or 1, and the
-    // sum and count of the fully inked pixels' levels.
-    let (binary, sum, n) = raw
+    // One pass over the bytes (in parallel; integer counts, so in any
+    // order): how many pixels hold each grey level. Whether every level
+    // present has coverage exactly 0 or 1, and the sum and count of the
+    // fully inked pixels' levels, are then read off the 256 counts.
+    let counts = raw
         .par_chunks(1 << 16)
         .map(|chunk| {
-            let (mut binary, mut sum, mut n) = (true, 0u64, 0u64);
+            let mut counts = [0u32; 256];
             for &v in chunk {
-                let c = level[usize::from(v)];
-                binary &= c == 0.0 || c == 1.0;
-                if c > 0.95 {
-                    sum += v as u64;
-                    n += 1;
-                }
+                counts[usize::from(v)] += 1;
             }
-            (binary, sum, n)
+            counts
         })
-        .reduce(|| (true, 0, 0), |a, b| (a.0 && b.0, a.1 + b.1, a.2 + b.2));
+        .reduce(
+            || [0u32; 256],
+            |mut a, b| {
+                for (x, y) in a.iter_mut().zip(b) {
+                    *x += y;
+                }
+                a
+            },
+        );
+    let (mut binary, mut sum, mut n) = (true, 0u64, 0u64);
+    for ((v, &count), &c) in counts.iter().enumerate().zip(&level) {
+        if count == 0 {
+            continue;
+        }
+        binary &= c == 0.0 || c == 1.0;
+        if c > 0.95 {
+            sum += v as u64 * u64::from(count);
+            n += u64::from(count);
+        }
+    }
     let color = sum.checked_div(n).map_or(Color::BLACK, |g| {
         let g = g as u8;
         Color::rgb(g, g, g)

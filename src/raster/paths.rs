@@ -100,6 +100,12 @@ impl Bitmap {
         self.flags.get(i).is_some_and(|&f| f != 0)
     }
 
+    /// The padded flags, row by row (`width + 2` flags each, `height + 2`
+    /// rows; 1 for ink).
+    pub(crate) fn flags(&self) -> &[u8] {
+        &self.flags
+    }
+
     /// The padded rows (`width + 2` flags each, `height + 2` of them).
     pub(crate) fn padded_rows(&self) -> std::slice::Chunks<'_, u8> {
         self.flags.chunks(self.width + 2)
@@ -173,33 +179,6 @@ impl Link {
             Point::new(x, y + 0.5)
         }
     }
-
-    /// Edge `e` of cell (x, y) (corners (x, y) to (x + 1, y + 1)), in
-    /// clockwise order (y down): top, right, bottom, left.
-    fn of_cell(x: i32, y: i32, e: u8) -> Link {
-        match e {
-            0 => Link {
-                horizontal: true,
-                x,
-                y,
-            },
-            1 => Link {
-                horizontal: false,
-                x: x + 1,
-                y,
-            },
-            2 => Link {
-                horizontal: true,
-                x,
-                y: y + 1,
-            },
-            _ => Link {
-                horizontal: false,
-                x,
-                y,
-            },
-        }
-    }
 }
 
 /// `PARTNER[case][e]`: in a cell whose corners (top-left, top-right,
@@ -243,9 +222,17 @@ const fn partner_table() -> [[u8; 4]; 16] {
 /// ([`crate::trace::contour::signed_area`]), holes negative; vertices at
 /// the midpoints of pixel edges, in pixel coordinates.
 pub fn paths(bits: &Bitmap) -> Vec<Vec<Point>> {
+    let mut out = Vec::new();
+    for_each_path(bits, |p| out.push(p));
+    out
+}
+
+/// [`paths`], each handed to `found` as soon as it is walked (in the same
+/// order), so its processing can start while the walk goes on.
+pub fn for_each_path(bits: &Bitmap, mut found: impl FnMut(Vec<Point>)) {
     let (w, h) = (bits.width, bits.height);
     if w == 0 || h == 0 {
-        return Vec::new();
+        return;
     }
     let pw = w + 2;
     // Horizontal links already on a path: (w + 1) per padded row. Every
@@ -254,7 +241,6 @@ pub fn paths(bits: &Bitmap) -> Vec<Vec<Point>> {
     let mut seen = vec![false; (w + 1) * (h + 2)];
     // A loop cannot be longer than there are links.
     let cap = 2 * (w + 1) * (h + 2) + 2 * w + 2;
-    let mut out = Vec::new();
     for (yi, row) in bits.padded_rows().enumerate() {
         let mut xi = 0usize;
         while xi + 1 < pw {
@@ -278,45 +264,61 @@ pub fn paths(bits: &Bitmap) -> Vec<Vec<Point>> {
                     x: xi as i32 - 1,
                     y: yi as i32 - 1,
                 };
-                out.push(walk(bits, start, &mut seen, cap));
+                found(walk(bits, start, &mut seen, cap));
             }
             xi += 1;
         }
     }
-    out
 }
 
 /// Follows the loop through `start` (a crossed horizontal link) until it
 /// closes, marking its horizontal links in `seen`.
+///
+/// The walk works on the padded flags directly: a link is kept as its
+/// first pixel's (x, y) and that pixel's padded index `k`, so each of a
+/// cell's four corners is one lookup at `c`, `c + 1`, `c + pw + 1` and
+/// `c + pw` from its top-left corner's index `c`.
 fn walk(bits: &Bitmap, start: Link, seen: &mut [bool], cap: usize) -> Vec<Point> {
-    let w = bits.width;
-    let ink = |x: i32, y: i32| bits.ink(x as isize, y as isize);
+    let pw = bits.width + 2;
+    let f = bits.flags.as_slice();
+    // Padded index of pixel (x, y), x and y from −1; out of range reads as
+    // paper (a crossed link never reaches there).
+    let index = |x: i32, y: i32| (y + 1) as usize * pw + (x + 1) as usize;
+    let ink = |k: usize| f.get(k).is_some_and(|&v| v != 0);
     let mut pts = Vec::new();
-    let mut cur = start;
+    let (mut horizontal, mut x, mut y) = (start.horizontal, start.x, start.y);
+    let mut k = index(x, y);
     loop {
+        let cur = Link { horizontal, x, y };
         pts.push(cur.point());
-        // The cell in which the path leaves the ink across `cur`
-        // (clockwise), and which of its edges `cur` is.
-        let (cx, cy, e) = if cur.horizontal {
-            if let Some(s) = seen.get_mut((cur.y + 1) as usize * (w + 1) + (cur.x + 1) as usize) {
+        // The cell in which the path leaves the ink across the link
+        // (clockwise), its top-left corner's index, and which of its edges
+        // the link is.
+        let (cx, cy, c, e) = if horizontal {
+            // Horizontal links of padded row y + 1 start at (y + 1)(w + 1).
+            if let Some(s) = seen.get_mut(k.wrapping_sub((y + 1) as usize)) {
                 *s = true;
             }
-            if ink(cur.x, cur.y) {
-                (cur.x, cur.y, 0)
+            if ink(k) {
+                (x, y, k, 0)
             } else {
-                (cur.x, cur.y - 1, 2)
+                (x, y - 1, k.wrapping_sub(pw), 2)
             }
-        } else if ink(cur.x, cur.y) {
-            (cur.x - 1, cur.y, 1)
+        } else if ink(k) {
+            (x - 1, y, k.wrapping_sub(1), 1)
         } else {
-            (cur.x, cur.y, 3)
+            (x, y, k, 3)
         };
-        let case = usize::from(ink(cx, cy))
-            | usize::from(ink(cx + 1, cy)) << 1
-            | usize::from(ink(cx + 1, cy + 1)) << 2
-            | usize::from(ink(cx, cy + 1)) << 3;
-        cur = Link::of_cell(cx, cy, PARTNER[case][e]);
-        if cur == start || pts.len() > cap {
+        let at = |d: usize| usize::from(ink(c.wrapping_add(d)));
+        let case = at(0) | at(1) << 1 | at(pw + 1) << 2 | at(pw) << 3;
+        // Edge `e` of cell (cx, cy), clockwise: top, right, bottom, left.
+        (horizontal, x, y, k) = match PARTNER[case][e] {
+            0 => (true, cx, cy, c),
+            1 => (false, cx + 1, cy, c.wrapping_add(1)),
+            2 => (true, cx, cy + 1, c.wrapping_add(pw)),
+            _ => (false, cx, cy, c),
+        };
+        if (horizontal, x, y) == (start.horizontal, start.x, start.y) || pts.len() > cap {
             return pts;
         }
     }

@@ -37,7 +37,7 @@ pub(super) enum Guide<'a> {
     /// bitmap's outline, by the bitmap's [`Corridor`]: then a curve may
     /// stray up to [`Corridor::HALF_WIDTH`] further from the smooth outline
     /// as long as it stays within the accuracy of the corridor.
-    Outline(Option<&'a Corridor>),
+    Outline(Option<&'a Corridor<'a>>),
 }
 
 /// How far `p` (px) lies inside the canvas of `sdf`'s grid, negated: the

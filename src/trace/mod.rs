@@ -221,48 +221,61 @@ pub fn trace_outline(
 /// Traces a binary bitmap's ink: what [`trace_outline`] makes of its
 /// smoothed loops ([`crate::raster::binary::bitmap_loops`]) and its
 /// [`Corridor`], path by path. Each path is smoothed and fitted in one
-/// task (one parallel pass with no barrier between the two stages, and
-/// no loop kept once fitted), and islands are nested on the pixel paths
+/// task, started as soon as the path is found (the walk round the pixel
+/// edges is sequential; the other threads fit what it has found so far),
+/// with no loop kept once fitted. Islands are nested on the pixel paths
 /// themselves, whose containment is the smoothed loops' (the loops stay
 /// within half a pixel of their paths, which lie a pixel apart or more).
+/// Each result goes back to its path's place, so the output does not
+/// depend on the thread count.
 pub fn trace_bitmap(bits: &Bitmap, opts: &TraceOptions) -> Vec<BezPath> {
-    let (paths, corridor) = rayon::join(|| paths::paths(bits), || Corridor::from_bitmap(bits));
-    let polys: Vec<&[Point]> = paths.iter().map(Vec::as_slice).collect();
-    let areas: Vec<f64> = paths.iter().map(|p| paths::pixel_area(p)).collect();
-    let (islands, mut fitted) = rayon::join(
-        || nest_polygons(&polys, &areas, opts.min_area),
-        || {
-            // Longest paths first, one task each, so the largest outline
-            // does not start last and leave the other threads idle; the
-            // results go back to their paths' places.
-            let mut order: Vec<usize> = (0..paths.len()).collect();
-            order.sort_by_key(|&i| std::cmp::Reverse(paths[i].len()));
-            let mut done: Vec<(usize, BezPath)> = order
-                .par_iter()
-                .with_max_len(1)
-                .map(|&i| {
-                    let (p, area) = (&paths[i], areas[i]);
-                    let mut path = BezPath::new();
-                    if area.abs() >= opts.min_area {
-                        let l = binary::smooth_loop(p);
-                        if l.points.len() >= 3 {
-                            cover::fit_outline(
-                                &l.points,
-                                &l.tangents,
-                                &l.corners,
-                                opts.tolerance,
-                                Some(&corridor),
-                                &mut path,
-                            );
-                        }
-                    }
-                    (i, path)
-                })
-                .collect();
-            done.sort_unstable_by_key(|d| d.0);
-            done.into_iter().map(|d| d.1).collect::<Vec<BezPath>>()
-        },
-    );
+    let corridor = Corridor::from_bitmap(bits);
+    let fit = |p: &[Point]| {
+        let mut path = BezPath::new();
+        let l = binary::smooth_loop(p);
+        if l.points.len() >= 3 {
+            cover::fit_outline(
+                &l.points,
+                &l.tangents,
+                &l.corners,
+                opts.tolerance,
+                Some(&corridor),
+                &mut path,
+            );
+        }
+        path
+    };
+    let done: std::sync::Mutex<Vec<(usize, BezPath)>> = std::sync::Mutex::new(Vec::new());
+    let mut paths: Vec<std::sync::Arc<Vec<Point>>> = Vec::new();
+    let mut areas: Vec<f64> = Vec::new();
+    let mut islands = Vec::new();
+    rayon::scope(|s| {
+        paths::for_each_path(bits, |p| {
+            let i = paths.len();
+            let area = paths::pixel_area(&p);
+            let p = std::sync::Arc::new(p);
+            if area.abs() >= opts.min_area {
+                let (p, fit, done) = (p.clone(), &fit, &done);
+                s.spawn(move |_| {
+                    let path = fit(&p);
+                    // A poisoned lock only means another task panicked,
+                    // which the scope reports anyway.
+                    let mut done = done.lock().unwrap_or_else(|e| e.into_inner());
+                    done.push((i, path));
+                });
+            }
+            paths.push(p);
+            areas.push(area);
+        });
+        let polys: Vec<&[Point]> = paths.iter().map(|p| p.as_slice()).collect();
+        islands = nest_polygons(&polys, &areas, opts.min_area);
+    });
+    let mut fitted = vec![BezPath::new(); paths.len()];
+    for (i, path) in done.into_inner().unwrap_or_else(|e| e.into_inner()) {
+        if let Some(slot) = fitted.get_mut(i) {
+            *slot = path;
+        }
+    }
     assemble(&islands, &mut fitted)
 }
 
