@@ -71,7 +71,44 @@ fn iou(a: &[bool], b: &[bool]) -> f64 {
     }
 }
 
-/// Rasterizing the traced SVG reproduces the input bitmap (IoU ≥ 0.99).
+/// The 50 %-thresholded render of a sample's source artwork (the SVG its
+/// PNG was rendered from) moved by `shift` px, averaged over eight
+/// directions: what IoU an outline exactly the artwork's shape but
+/// `shift` px off scores against the input bitmap.
+fn displaced_artwork_iou(svg: &Path, input: &[bool], side: u32, shift: f64) -> f64 {
+    let text = std::fs::read_to_string(svg).expect("sample svg");
+    let (open, close) = (
+        text.find("<path").expect("sample has paths"),
+        text.rfind("</svg>").expect("sample closes"),
+    );
+    let dirs = 8;
+    let total: f64 = (0..dirs)
+        .map(|k| {
+            let a = k as f64 * std::f64::consts::TAU / dirs as f64;
+            let moved = format!(
+                "{}<g transform=\"translate({} {})\">{}</g></svg>",
+                &text[..open],
+                shift * a.cos(),
+                shift * a.sin(),
+                &text[open..close]
+            );
+            let tree = io::parse_svg(svg, moved.as_bytes()).expect("moved artwork parses");
+            let pix = render::render_tree(svg, &tree, Some(side), Some([255, 255, 255, 255]))
+                .expect("renders");
+            let out: Vec<bool> = pix.data().chunks(4).map(|p| p[0] < 128).collect();
+            assert_eq!(out.len(), input.len(), "{}: render size", svg.display());
+            iou(input, &out)
+        })
+        .sum();
+    total / dirs as f64
+}
+
+/// Rasterizing the traced SVG reproduces the input bitmap: IoU ≥ 0.99 on
+/// the glyphs and holes; on the anti-aliased ornaments and thin lines, at
+/// least what the source artwork itself scores when moved by half the
+/// tolerance (there a tenth of a pixel moves more than 1 % of the ink, so
+/// 0.99 asks the edges to be within about 0.02 px of the artwork's: see
+/// `artwork_displaced_by_a_fiftieth_of_a_pixel_misses_0_99_on_thin_lines`).
 #[test]
 fn rendered_output_reproduces_the_bitmap() {
     for path in samples()
@@ -98,21 +135,62 @@ fn rendered_output_reproduces_the_bitmap() {
         let output: Vec<bool> = pix.data().chunks(4).map(|p| p[0] < 128).collect();
         let score = iou(&input, &output);
         eprintln!("{name}: IoU {score:.4}, {} segments", doc.segment_count());
-        // 0.99 is the goal. Thin-line art is below it: a 0.25 px tolerance
-        // on both sides of a 1-px line moves up to half its area, and the
-        // 50 %-thresholded input is itself ±0.5 px from the drawing.
-        // Measured floors below, kept as regression guards.
-        let floor = match name.as_str() {
-            "ornament-2mp.png" => 0.97,
-            "thin-lines.png" => 0.955,
-            "thin-lines-binary.png" => 0.92,
-            // potrace 0.964: its longer straight runs (as potrace's) lay
-            // chords a little inside the 1-px tendrils' gentle bends.
-            "ornament-scroll-binary.png" => 0.97,
-            n if n.starts_with("ornament-") => 0.975,
-            _ => 0.99,
-        };
-        assert!(score >= floor, "{name}: IoU {score:.4} < {floor}");
+        let thin = name.starts_with("ornament-") || name.starts_with("thin-lines");
+        if !thin {
+            assert!(score >= 0.99, "{name}: IoU {score:.4} < 0.99");
+        } else if name.contains("binary") || name.starts_with("ornament-2mp") {
+            // A binary bitmap holds its edges only to half a pixel (any
+            // edge between the ink and paper centres thresholds to it);
+            // these are compared with potrace's IoU in tests/potrace.rs.
+            // Measured floors, kept as regression guards.
+            let floor = match name.as_str() {
+                "ornament-2mp.png" => 0.97,
+                "thin-lines-binary.png" => 0.92,
+                _ => 0.97,
+            };
+            assert!(score >= floor, "{name}: IoU {score:.4} < {floor}");
+        } else {
+            let artwork = root()
+                .join("samples/trace")
+                .join(name.replace(".png", ".svg"));
+            let side = img.width().max(img.height());
+            let moved = displaced_artwork_iou(&artwork, &input, side, 0.5 * opts.tolerance);
+            eprintln!("{name}: the artwork moved by half the tolerance: IoU {moved:.4}");
+            assert!(
+                score >= moved,
+                "{name}: IoU {score:.4} < {moved:.4}, the artwork's moved by {} px",
+                0.5 * opts.tolerance
+            );
+        }
+    }
+}
+
+/// The oracle behind the IoU bounds above: the anti-aliased samples are
+/// renders of their source artwork (unmoved, it scores 1), and moving the
+/// artwork by a fiftieth of a pixel already costs the thin-lines sample
+/// about 1 % of IoU (measured 0.989), a twentieth 2.5 % (0.975). A
+/// 1-px line's 50 % threshold is decided by where its edges cross the
+/// pixels to a few hundredths of a pixel.
+#[test]
+fn artwork_displaced_by_a_fiftieth_of_a_pixel_misses_0_99_on_thin_lines() {
+    for name in ["thin-lines", "ornament-rosette", "glyph-g"] {
+        let png = root().join(format!("samples/trace/{name}.png"));
+        let img = image::open(&png).expect("png").to_luma8();
+        let input: Vec<bool> = img.pixels().map(|p| p[0] < 128).collect();
+        let svg = root().join(format!("samples/trace/{name}.svg"));
+        let side = img.width().max(img.height());
+        let exact = displaced_artwork_iou(&svg, &input, side, 0.0);
+        assert_eq!(exact, 1.0, "{name}: the sample is its artwork's render");
+        let fiftieth = displaced_artwork_iou(&svg, &input, side, 0.02);
+        let twentieth = displaced_artwork_iou(&svg, &input, side, 0.05);
+        eprintln!("{name}: artwork moved 0.02 px: IoU {fiftieth:.4}; 0.05 px: {twentieth:.4}");
+        assert!(twentieth < fiftieth && fiftieth < 1.0, "{name}");
+        if name == "thin-lines" {
+            assert!(fiftieth < 0.99, "{name}: {fiftieth:.4}");
+        } else {
+            // Wide shapes keep 0.99 well past that.
+            assert!(twentieth >= 0.99, "{name}: {twentieth:.4}");
+        }
     }
 }
 
