@@ -453,6 +453,54 @@ fn all_white_image_gives_valid_empty_svg() {
     assert!(!tree.root().has_children(), "empty output has content");
 }
 
+/// A drawing in a light ink (yellow, light grey: darkness 0.2–0.4, under
+/// the half that black ink's edges are read at) traces as a drawing, in
+/// its ink's colour and at its drawn size, not as an empty page.
+#[test]
+fn light_ink_drawings_are_traced_in_their_colour() {
+    use kurbo::Shape;
+    let t = tempdir();
+    let (size, r) = (120u32, 36.0);
+    let c = size as f64 / 2.0;
+    let grey = render_gray(size, size, 4, disc(c, c, r));
+    let yellow = image::RgbImage::from_fn(size, size, |x, y| {
+        let k = 1.0 - grey.get_pixel(x, y)[0] as f64 / 255.0;
+        let mix = |ink: f64| (255.0 + k * (ink - 255.0)).round() as u8;
+        image::Rgb([mix(240.0), mix(200.0), mix(40.0)])
+    });
+    let light_grey = image::GrayImage::from_fn(size, size, |x, y| {
+        let k = 1.0 - grey.get_pixel(x, y)[0] as f64 / 255.0;
+        image::Luma([(255.0 + k * (170.0 - 255.0)).round() as u8])
+    });
+    let yp = t.path().join("yellow.png");
+    let gp = t.path().join("light-grey.png");
+    yellow.save(&yp).unwrap();
+    light_grey.save(&gp).unwrap();
+    for (p, fill) in [(&yp, "#f0c828"), (&gp, "#aaa")] {
+        let out = t.path().join("out.svg");
+        let o = flourish(&["trace", s(p), "-o", s(&out)]);
+        assert_eq!(code(&o), Some(0), "stderr: {}", stderr(&o));
+        let text = std::fs::read_to_string(&out).unwrap();
+        assert!(
+            text.contains(&format!("fill=\"{fill}\"")),
+            "{}: {text}",
+            p.display()
+        );
+        let d = text
+            .split(" d=\"")
+            .nth(1)
+            .and_then(|r| r.split('"').next())
+            .expect("a path");
+        let area = kurbo::BezPath::from_svg(d).expect("path data").area().abs();
+        let drawn = std::f64::consts::PI * r * r;
+        assert!(
+            (area / drawn - 1.0).abs() < 0.01,
+            "{}: area {area:.1} vs {drawn:.1}",
+            p.display()
+        );
+    }
+}
+
 #[test]
 fn transparent_image_gives_valid_empty_svg() {
     let t = tempdir();

@@ -114,16 +114,29 @@ pub(super) fn raster_coverage(
             layers: quantized_layers(&px, w, h, has_alpha, opts.invert),
         })
     } else {
+        // Raw coverage (alpha, or darkness on an opaque image), then put on
+        // the scale of the image's own paper and ink.
+        let raw: Vec<f32> = px
+            .par_iter()
+            .map(|p| {
+                if has_alpha {
+                    p[3] as f32 / 255.0
+                } else {
+                    1.0 - luma(p)
+                }
+            })
+            .collect();
+        let mut scale = InkScale::of_values(&raw);
+        if !has_alpha && !one_ink(&px, &raw, scale) {
+            // Several inks: each is read by its own darkness, as it is.
+            scale = InkScale::RAW;
+        }
         let cov = Grid::from_vec(
             w,
             h,
-            px.iter()
-                .map(|p| {
-                    let c = if has_alpha {
-                        p[3] as f32 / 255.0
-                    } else {
-                        1.0 - luma(p)
-                    };
+            raw.par_iter()
+                .map(|&c| {
+                    let c = scale.coverage(c);
                     if opts.invert {
                         1.0 - c
                     } else {
@@ -155,16 +168,6 @@ pub(super) fn raster_coverage(
 /// path gives) and the same mean ink colour, grey.
 fn grey_coverage(grey: &image::GrayImage, invert: bool) -> RasterCoverage {
     let (w, h) = (grey.width() as usize, grey.height() as usize);
-    // Coverage of each of the 256 grey levels, computed once.
-    let level: [f32; 256] = std::array::from_fn(|v| {
-        let g = v as u8;
-        let c = 1.0 - luma(&[g, g, g, 255]);
-        if invert {
-            1.0 - c
-        } else {
-            c
-        }
-    });
     let raw = grey.as_raw();
     let raw = raw.get(..w * h).unwrap_or(raw);
     // One pass over the bytes (in parallel; integer counts, so in any
@@ -189,6 +192,25 @@ fn grey_coverage(grey: &image::GrayImage, invert: bool) -> RasterCoverage {
                 a
             },
         );
+    // Darkness of each of the 256 grey levels, and the image's paper and
+    // ink on that scale (darkness bins run the other way: bin 255 − v).
+    let dark: [f32; 256] = std::array::from_fn(|v| {
+        let g = v as u8;
+        1.0 - luma(&[g, g, g, 255])
+    });
+    let scale =
+        InkScale::from_histogram(&std::array::from_fn(|b| u64::from(counts[255 - b])), |b| {
+            dark[255 - b]
+        });
+    // Coverage of each level, computed once.
+    let level: [f32; 256] = std::array::from_fn(|v| {
+        let c = scale.coverage(dark[v]);
+        if invert {
+            1.0 - c
+        } else {
+            c
+        }
+    });
     let (mut binary, mut sum, mut n) = (true, 0u64, 0u64);
     for ((v, &count), &c) in counts.iter().enumerate().zip(&level) {
         if count == 0 {
@@ -220,6 +242,160 @@ fn grey_coverage(grey: &image::GrayImage, invert: bool) -> RasterCoverage {
         h,
         layers: vec![(color, cov)],
     }
+}
+
+/// Raw coverage (alpha or darkness) below which, above the paper's own,
+/// a pixel is still paper: off-white paper, scanner noise, JPEG ringing.
+const PAPER_NOISE: f32 = 0.1;
+
+/// Share of the inked pixels that may be darker than the level taken for
+/// the ink (stray dark specks on a coloured drawing).
+const INK_OUTLIERS: f64 = 0.001;
+
+/// Where a raster's paper and its ink lie on the raw coverage scale
+/// (alpha, or darkness `1 − luma`). Coverage is the share of ink in a
+/// pixel, so a pixel is read as `(c − paper) / (ink − paper)`: a drawing
+/// in yellow or light-grey ink traces as a drawing (its strokes' raw
+/// darkness, 0.2–0.4, is under one half), its anti-aliased edges at their
+/// true share, and black ink on white paper (paper 0, ink 1) exactly as
+/// the raw value. Several inks of different darkness are measured against
+/// the darkest (`--layers` traces each colour on its own).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct InkScale {
+    /// Raw coverage of the paper: the most common level under
+    /// [`PAPER_NOISE`].
+    paper: f32,
+    /// Raw coverage of the ink: of the pixels at least [`PAPER_NOISE`]
+    /// above the paper, the darkest level with no more than
+    /// [`INK_OUTLIERS`] of them darker still.
+    ink: f32,
+}
+
+impl InkScale {
+    /// Raw values as they are: paper 0, ink 1.
+    const RAW: InkScale = InkScale {
+        paper: 0.0,
+        ink: 1.0,
+    };
+
+    /// The scale of a histogram of raw coverage in 256 bins, lightest
+    /// first; `value(b)` is the raw coverage of bin `b`'s pixels (for a
+    /// bin holding several values, its largest). [`InkScale::RAW`] when no
+    /// pixel stands out from the paper.
+    fn from_histogram(counts: &[u64; 256], value: impl Fn(usize) -> f32) -> InkScale {
+        let held = |b: &usize| counts[*b] > 0;
+        let paper = (0..256)
+            .filter(held)
+            .filter(|&b| value(b) < PAPER_NOISE)
+            .max_by_key(|&b| (counts[b], std::cmp::Reverse(b)))
+            .map_or(0.0, &value);
+        let inked: Vec<usize> = (0..256)
+            .filter(held)
+            .filter(|&b| value(b) >= paper + PAPER_NOISE)
+            .collect();
+        let total: u64 = inked.iter().map(|&b| counts[b]).sum();
+        let allowed = (total as f64 * INK_OUTLIERS) as u64;
+        let mut darker = 0u64;
+        for &b in inked.iter().rev() {
+            darker += counts[b];
+            if darker > allowed {
+                return InkScale {
+                    paper,
+                    ink: value(b),
+                };
+            }
+        }
+        InkScale::RAW
+    }
+
+    /// The scale of raw coverage values in 0..=1 (binned by 1/255).
+    fn of_values(raw: &[f32]) -> InkScale {
+        let bin = |c: f32| ((c.clamp(0.0, 1.0) * 255.0).round() as usize).min(255);
+        let (counts, top) = raw
+            .par_chunks(1 << 16)
+            .map(|chunk| {
+                let (mut counts, mut top) = ([0u64; 256], [0f32; 256]);
+                for &c in chunk {
+                    let b = bin(c);
+                    counts[b] += 1;
+                    top[b] = top[b].max(c);
+                }
+                (counts, top)
+            })
+            .reduce(
+                || ([0u64; 256], [0f32; 256]),
+                |(mut n, mut t), (m, u)| {
+                    for b in 0..256 {
+                        n[b] += m[b];
+                        t[b] = t[b].max(u[b]);
+                    }
+                    (n, t)
+                },
+            );
+        InkScale::from_histogram(&counts, |b| top[b])
+    }
+
+    /// A raw value's coverage, 0 (paper) to 1 (ink).
+    fn coverage(&self, c: f32) -> f32 {
+        if *self == InkScale::RAW {
+            return c;
+        }
+        ((c - self.paper) / (self.ink - self.paper)).clamp(0.0, 1.0)
+    }
+}
+
+/// Largest distance (RGB, 0..=1 per channel) from the mix of paper and
+/// ink at which a pixel still counts as that mix, for [`one_ink`].
+const MIX_TOLERANCE: f32 = 0.1;
+
+/// Whether an opaque image's inked pixels are all mixes of one ink with the
+/// paper (anti-aliased edges of a one-colour drawing): no more than 10 % of
+/// the pixels above the paper (a JPEG's chroma bleeding puts about 4 % of
+/// a small drawing's off the line) lie farther than [`MIX_TOLERANCE`] from the
+/// RGB segment between the paper's and the ink's mean colours. Only then
+/// is the image's coverage put on [`InkScale`]; a drawing in several inks
+/// keeps each pixel's own darkness (its lighter inks are not measured
+/// against the darkest).
+fn one_ink(px: &[[u8; 4]], raw: &[f32], scale: InkScale) -> bool {
+    if scale == InkScale::RAW {
+        return true;
+    }
+    let rgb = |p: &[u8; 4]| [p[0], p[1], p[2]].map(|v| v as f32 / 255.0);
+    let mean = |near: f32| {
+        let (sum, n) = px
+            .iter()
+            .zip(raw)
+            .filter(|(_, &c)| (c - near).abs() <= 1.0 / 255.0)
+            .fold(([0f64; 3], 0u64), |(mut s, n), (p, _)| {
+                for (a, b) in s.iter_mut().zip(rgb(p)) {
+                    *a += f64::from(b);
+                }
+                (s, n + 1)
+            });
+        sum.map(|v| (v / n.max(1) as f64) as f32)
+    };
+    let (paper, ink) = (mean(scale.paper), mean(scale.ink));
+    let d: [f32; 3] = std::array::from_fn(|k| ink[k] - paper[k]);
+    let len2: f32 = d.iter().map(|v| v * v).sum();
+    let (mut inked, mut off) = (0u64, 0u64);
+    for (p, &c) in px.iter().zip(raw) {
+        if c < scale.paper + PAPER_NOISE {
+            continue;
+        }
+        inked += 1;
+        let q = rgb(p);
+        let v: [f32; 3] = std::array::from_fn(|k| q[k] - paper[k]);
+        let t = if len2 > 0.0 {
+            (v.iter().zip(&d).map(|(a, b)| a * b).sum::<f32>() / len2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let dist2: f32 = v.iter().zip(&d).map(|(a, b)| (a - t * b).powi(2)).sum();
+        if dist2 > MIX_TOLERANCE * MIX_TOLERANCE {
+            off += 1;
+        }
+    }
+    off * 10 <= inked
 }
 
 fn luma(p: &[u8; 4]) -> f32 {
@@ -401,13 +577,17 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
 
-    /// The grey path as first written: a coverage grid, checked for 0/1
-    /// values, then the bitmap of its ink; the mean level of pixels with
-    /// coverage above 0.95.
+    /// The grey path as first written: a coverage grid (darkness on the
+    /// image's [`InkScale`], as the colour path measures it), checked for
+    /// 0/1 values, then the bitmap of its ink; the mean level of pixels
+    /// with coverage above 0.95.
     fn reference(grey: &image::GrayImage, invert: bool) -> (bool, Color, Coverage) {
+        let dark = |g: u8| 1.0 - luma(&[g, g, g, 255]);
+        let raw: Vec<f32> = grey.pixels().map(|p| dark(p[0])).collect();
+        let scale = InkScale::of_values(&raw);
         let cov = Grid::from_fn(grey.width() as usize, grey.height() as usize, |x, y| {
             let g = grey.get_pixel(x as u32, y as u32)[0];
-            let c = 1.0 - luma(&[g, g, g, 255]);
+            let c = scale.coverage(dark(g));
             if invert {
                 1.0 - c
             } else {
@@ -504,5 +684,76 @@ mod tests {
         assert!(layers[0].0 == Color::rgb(0, 0, 0), "{:?}", layers[0].0);
         let layers = quantized_layers(&picture(true), w, h, false, false);
         assert_eq!(layers.len(), 2);
+    }
+
+    /// Black ink on white reads as it is; one lighter ink is put on its
+    /// own scale (stray darker specks ignored); paper alone stays raw.
+    #[test]
+    fn ink_scale_reads_the_drawing_not_the_darkness() {
+        let hist = |pairs: &[(usize, u64)]| {
+            let mut h = [0u64; 256];
+            for &(b, n) in pairs {
+                h[b] = n;
+            }
+            h
+        };
+        let value = |b: usize| b as f32 / 255.0;
+        // Black on white, anti-aliased.
+        let black = InkScale::from_histogram(&hist(&[(0, 9000), (128, 40), (255, 500)]), value);
+        assert_eq!(black, InkScale::RAW);
+        assert_eq!(black.coverage(0.3), 0.3);
+        // Yellow (darkness 0.3) on off-white (0.04), with one black speck.
+        let yellow =
+            InkScale::from_histogram(&hist(&[(10, 9000), (40, 30), (77, 3000), (255, 1)]), value);
+        assert_eq!((yellow.paper, yellow.ink), (value(10), value(77)));
+        assert_eq!(yellow.coverage(value(77)), 1.0);
+        assert_eq!(yellow.coverage(value(10)), 0.0);
+        assert!((yellow.coverage(0.5 * (value(10) + value(77))) - 0.5).abs() < 1e-6);
+        assert_eq!(yellow.coverage(1.0), 1.0);
+        // Nothing above the paper noise.
+        let blank = InkScale::from_histogram(&hist(&[(0, 9000), (12, 30)]), value);
+        assert_eq!(blank, InkScale::RAW);
+    }
+
+    /// A drawing in one light ink traces as a drawing, in its colour; two
+    /// inks keep each pixel's own darkness.
+    #[test]
+    fn one_light_ink_is_traced_and_two_inks_are_read_as_they_are() {
+        let (w, h) = (64usize, 48usize);
+        let picture = |second: bool| -> Vec<[u8; 4]> {
+            (0..w * h)
+                .map(|i| {
+                    let (x, y) = ((i % w) as f64 + 0.5, (i / w) as f64 + 0.5);
+                    let c = (0.5 - ((x - 24.0).hypot(y - 24.0) - 12.0)).clamp(0.0, 1.0);
+                    let ink = [240.0, 200.0, 40.0];
+                    let mix = |k: usize| (255.0 + c * (ink[k] - 255.0)).round() as u8;
+                    if second && x > 40.0 && y < 20.0 {
+                        [20, 40, 160, 255]
+                    } else {
+                        [mix(0), mix(1), mix(2), 255]
+                    }
+                })
+                .collect()
+        };
+        let raw_of = |px: &[[u8; 4]]| px.iter().map(|p| 1.0 - luma(p)).collect::<Vec<f32>>();
+        let one = picture(false);
+        let raw = raw_of(&one);
+        let scale = InkScale::of_values(&raw);
+        assert!(one_ink(&one, &raw, scale));
+        // Every pixel reads as the share of the disc it holds (a yellow
+        // disc's centre is 0.3 dark: raw, nothing of it would be ink).
+        assert_eq!(scale.coverage(raw[24 * w + 24]), 1.0);
+        let mut rim = 0;
+        for (i, &r) in raw.iter().enumerate() {
+            let (x, y) = ((i % w) as f64 + 0.5, (i / w) as f64 + 0.5);
+            let c = (0.5 - ((x - 24.0).hypot(y - 24.0) - 12.0)).clamp(0.0, 1.0);
+            let read = f64::from(scale.coverage(r));
+            assert!((read - c).abs() < 0.02, "({x}, {y}): {read} for {c}");
+            rim += usize::from(c > 0.05 && c < 0.95);
+        }
+        assert!(rim > 40, "{rim} rim pixels");
+        let two = picture(true);
+        let raw = raw_of(&two);
+        assert!(!one_ink(&two, &raw, InkScale::of_values(&raw)));
     }
 }
