@@ -727,3 +727,87 @@ fn anti_aliased_apexes_stay_sharp() {
     }
     assert_eq!(apexes, 16, "the drawn zigzags' apexes");
 }
+
+/// Clip paths, masks and group opacity are traced as they render (the
+/// drawing is rendered and its anti-aliased coverage traced), not as the
+/// bare fills under them: a disc clipped to its left half, a disc masked
+/// to its top half and a clipped disc at half opacity each trace to one
+/// loop of the visible half's area (within 1 %), in the SVG's units.
+#[test]
+fn clipped_and_masked_svg_traces_what_renders() {
+    use kurbo::Shape;
+    let dir = tempfile::tempdir().unwrap();
+    let half_disc = std::f64::consts::PI * 30.0 * 30.0 / 2.0;
+    let cases = [
+        (
+            "clip",
+            r##"<defs><clipPath id="c"><rect x="0" y="0" width="50" height="100"/></clipPath></defs>
+<circle cx="50" cy="50" r="30" fill="#123" clip-path="url(#c)"/>"##,
+        ),
+        (
+            "mask",
+            r##"<defs><mask id="m"><rect x="0" y="0" width="100" height="50" fill="white"/></mask></defs>
+<circle cx="50" cy="50" r="30" fill="#123" mask="url(#m)"/>"##,
+        ),
+        (
+            "faint",
+            r##"<defs><clipPath id="c"><rect x="50" y="0" width="50" height="100"/></clipPath></defs>
+<g opacity="0.5" clip-path="url(#c)"><circle cx="50" cy="50" r="30" fill="#123"/></g>"##,
+        ),
+    ];
+    for (name, body) in cases {
+        let p = dir.path().join(format!("{name}.svg"));
+        std::fs::write(
+            &p,
+            format!(
+                r#"<svg xmlns="http://www.w3.org/2000/svg" width="100" height="100" viewBox="0 0 100 100">{body}</svg>"#
+            ),
+        )
+        .unwrap();
+        let doc =
+            trace_file(&p, &InputOptions::default(), &TraceOptions::default()).expect("traces");
+        assert_eq!((doc.width, doc.height), (100.0, 100.0), "{name}");
+        let loops = traced_subpaths(&doc);
+        assert_eq!(loops.len(), 1, "{name}: {} loops", loops.len());
+        let area = loops[0].area().abs();
+        assert!(
+            (area / half_disc - 1.0).abs() < 0.01,
+            "{name}: area {area:.1} vs {half_disc:.1}"
+        );
+    }
+}
+
+/// The same route for a brush exemplar, whose `id="spine"` path is not ink
+/// even when drawn: the top-level nodes are rendered in place one by one,
+/// the spine left out.
+#[test]
+fn rendered_svg_leaves_out_the_spine_in_place() {
+    use kurbo::Shape;
+    let svg = r##"<svg xmlns="http://www.w3.org/2000/svg" width="100" height="100" viewBox="0 0 100 100">
+<defs><clipPath id="c"><rect x="0" y="0" width="50" height="100"/></clipPath></defs>
+<g transform="translate(10 0)"><circle cx="40" cy="50" r="30" fill="#123" clip-path="url(#c)"/></g>
+<path id="spine" d="M5 90 L95 90" stroke="#000" stroke-width="4" fill="none"/>
+</svg>"##;
+    let path = Path::new("exemplar.svg");
+    let tree = io::parse_svg(path, svg.as_bytes()).expect("parses");
+    let ink =
+        flourish::raster::input::svg_ink(path, &tree, &InputOptions::default(), Some("spine"))
+            .expect("ink");
+    let doc = trace_ink(&ink, &TraceOptions::default()).expect("traces");
+    let loops = traced_subpaths(&doc);
+    assert_eq!(loops.len(), 1, "{} loops", loops.len());
+    // The clip is in the circle's own frame: x < 50 there, x < 60 on the
+    // page, so 10 px more than the left half of the disc centred at 50.
+    let visible = {
+        let r: f64 = 30.0;
+        let a = (10.0 / r).asin();
+        0.5 * std::f64::consts::PI * r * r + (10.0 * (r * r - 100.0).sqrt() + r * r * a)
+    };
+    let area = loops[0].area().abs();
+    assert!(
+        (area / visible - 1.0).abs() < 0.01,
+        "area {area:.1} vs {visible:.1}"
+    );
+    let bb = loops[0].bounding_box();
+    assert!(bb.x0 > 19.0 && bb.x1 < 61.0 && bb.y1 < 81.0, "{bb:?}");
+}

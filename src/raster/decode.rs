@@ -60,9 +60,9 @@ pub(super) enum RasterCoverage {
 
 impl RasterCoverage {
     /// Each layer's SDF: a binary layer's from its smooth outline, others
-    /// from their anti-aliased coverage.
-    pub(super) fn into_ink(self) -> Ink {
-        let to_user = Affine::IDENTITY;
+    /// from their anti-aliased coverage; `to_user` maps pixels to the
+    /// input's units (the identity for raster files).
+    pub(super) fn into_ink(self, to_user: Affine) -> Ink {
         let (w, h, layers) = match self {
             RasterCoverage::Binary { w, h, color, bits } => (
                 w,
@@ -105,14 +105,26 @@ pub(super) fn raster_coverage(
     }
     let img = img.to_rgba8();
     let (w, h) = (img.width() as usize, img.height() as usize);
-    let has_alpha = img.pixels().any(|p| p[3] < 255);
     let px: Vec<[u8; 4]> = img.pixels().map(|p| p.0).collect();
+    Ok(pixel_coverage(&px, w, h, opts))
+}
+
+/// The ink coverage of `w` × `h` RGBA pixels (not premultiplied), row by
+/// row: alpha when any pixel is transparent, else darkness; one layer, or
+/// quantized colour layers with `--layers`.
+pub(super) fn pixel_coverage(
+    px: &[[u8; 4]],
+    w: usize,
+    h: usize,
+    opts: &InputOptions,
+) -> RasterCoverage {
+    let has_alpha = px.iter().any(|p| p[3] < 255);
     if opts.layers {
-        Ok(RasterCoverage::Layers {
+        RasterCoverage::Layers {
             w,
             h,
-            layers: quantized_layers(&px, w, h, has_alpha, opts.invert),
-        })
+            layers: quantized_layers(px, w, h, has_alpha, opts.invert),
+        }
     } else {
         // Raw coverage (alpha, or darkness on an opaque image), then put on
         // the scale of the image's own paper and ink.
@@ -127,7 +139,7 @@ pub(super) fn raster_coverage(
             })
             .collect();
         let mut scale = InkScale::of_values(&raw);
-        if !has_alpha && !one_ink(&px, &raw, scale) {
+        if !has_alpha && !one_ink(px, &raw, scale) {
             // Several inks: each is read by its own darkness, as it is.
             scale = InkScale::RAW;
         }
@@ -146,11 +158,11 @@ pub(super) fn raster_coverage(
                 .collect(),
         )
         .expect("sizes match");
-        let color = mean_ink_colour(&px, &cov);
+        let color = mean_ink_colour(px, &cov);
         // A binary bitmap stands for a smooth outline within half a pixel
         // of its staircase (see `binary`); anti-aliased coverage says where
         // the edge is.
-        Ok(if super::binary::is_binary(&cov) {
+        if super::binary::is_binary(&cov) {
             let bits = Bitmap::from_coverage(&cov);
             RasterCoverage::Binary { w, h, color, bits }
         } else {
@@ -159,7 +171,7 @@ pub(super) fn raster_coverage(
                 h,
                 layers: vec![(color, cov)],
             }
-        })
+        }
     }
 }
 

@@ -14,7 +14,7 @@
 //! extends under the layers above it, so stacked fills leave no seams.
 
 pub use super::decode::decode_raster;
-use super::decode::{raster_coverage, RasterCoverage};
+use super::decode::{pixel_coverage, raster_coverage, RasterCoverage};
 use super::{Grid, Sdf};
 use crate::error::{Error, Result};
 use crate::io;
@@ -187,7 +187,7 @@ pub fn load_traceable(path: &Path, opts: &InputOptions) -> Result<Traceable> {
 
 /// Raster bytes (PNG, JPEG, …) read from `path` as ink, as [`load`] reads them.
 pub fn load_raster(path: &Path, bytes: &[u8], opts: &InputOptions) -> Result<Ink> {
-    Ok(raster_coverage(path, bytes, opts)?.into_ink())
+    Ok(raster_coverage(path, bytes, opts)?.into_ink(Affine::IDENTITY))
 }
 
 /// One filled shape of an SVG, in pixel coordinates.
@@ -264,6 +264,65 @@ fn collect_shapes(
             _ => {}
         }
     }
+}
+
+/// Whether drawing `group` takes more than filling and stroking its paths:
+/// a clip path, a mask or a filter on it or anywhere below it. The exact
+/// outline route reads fills and strokes only, so such a drawing is
+/// rendered instead ([`rendered_ink`]).
+fn needs_render(group: &usvg::Group) -> bool {
+    group.clip_path().is_some()
+        || group.mask().is_some()
+        || !group.filters().is_empty()
+        || group.children().iter().any(|n| match n {
+            usvg::Node::Group(g) => needs_render(g),
+            _ => false,
+        })
+}
+
+/// The ink of an SVG drawn with clip paths, masks or filters: the drawing
+/// rendered (resvg, anti-aliased) on a `size` canvas with `canvas` placing
+/// it, and read as a transparent raster is (alpha as coverage, colour
+/// layers with `--layers`); `to_user` maps the canvas back to the SVG's
+/// units. With `skip_id`, the top-level nodes are rendered one by one and
+/// the one with that id is left out.
+fn rendered_ink(
+    path: &Path,
+    tree: &usvg::Tree,
+    opts: &InputOptions,
+    skip_id: Option<&str>,
+    (pw, ph): (usize, usize),
+    canvas: tiny_skia::Transform,
+    to_user: Affine,
+) -> Result<Ink> {
+    let mut pixmap = tiny_skia::Pixmap::new(pw as u32, ph as u32)
+        .ok_or_else(|| Error::invalid(path, "cannot allocate the render canvas"))?;
+    match skip_id {
+        None => resvg::render(tree, canvas, &mut pixmap.as_mut()),
+        Some(id) => {
+            for node in tree.root().children().iter().filter(|n| n.id() != id) {
+                // `render_node` draws a node at its layer box's origin.
+                if let Some(b) = node.abs_layer_bounding_box() {
+                    let at = canvas.pre_translate(b.x(), b.y());
+                    let _ = resvg::render_node(node, at, &mut pixmap.as_mut());
+                }
+            }
+        }
+    }
+    let px: Vec<[u8; 4]> = pixmap
+        .pixels()
+        .iter()
+        .map(|p| {
+            let c = p.demultiply();
+            [c.red(), c.green(), c.blue(), c.alpha()]
+        })
+        .collect();
+    let size = tree.size();
+    Ok(Ink {
+        width: size.width() as f64,
+        height: size.height() as f64,
+        ..pixel_coverage(&px, pw, ph, opts).into_ink(to_user)
+    })
 }
 
 /// A tiny-skia path as a kurbo path with `transform` applied.
@@ -475,6 +534,10 @@ pub fn svg_ink(
     io::check_canvas(path, pw.max(1), ph.max(1))?;
     let (pw, ph) = (pw.max(1) as usize, ph.max(1) as usize);
     let canvas = tiny_skia::Transform::from_scale(scale as f32, scale as f32);
+    let to_user = Affine::scale(1.0 / scale);
+    if needs_render(tree.root()) {
+        return rendered_ink(path, tree, opts, skip_id, (pw, ph), canvas, to_user);
+    }
     let mut shapes = Vec::new();
     collect_shapes(tree.root(), canvas, skip_id, &mut shapes);
     // Colours in order of first appearance: the stacking order.
@@ -484,7 +547,6 @@ pub fn svg_ink(
             colours.push(s.color);
         }
     }
-    let to_user = Affine::scale(1.0 / scale);
     let layer_sets: Vec<(Color, Vec<&SvgShape>)> = if opts.layers && !opts.invert {
         (0..colours.len())
             .map(|k| {
