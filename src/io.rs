@@ -80,6 +80,28 @@ pub fn parse_svg(path: &Path, data: &[u8]) -> Result<usvg::Tree> {
     Ok(tree)
 }
 
+/// Whether SVG data draws `<text>`: usvg drops text, as no fonts are
+/// read, so callers can say it is missing. Text inside `<defs>` (drawn
+/// only where used) is not counted.
+pub fn svg_has_text(data: &[u8]) -> bool {
+    let Ok(text) = std::str::from_utf8(data) else {
+        return false;
+    };
+    if !text.contains("text") {
+        return false;
+    }
+    let opts = usvg::roxmltree::ParsingOptions {
+        allow_dtd: true,
+        ..Default::default()
+    };
+    const SVG: &str = "http://www.w3.org/2000/svg";
+    usvg::roxmltree::Document::parse_with_options(text, opts).is_ok_and(|doc| {
+        doc.descendants().any(|n| {
+            n.has_tag_name((SVG, "text")) && !n.ancestors().any(|a| a.has_tag_name((SVG, "defs")))
+        })
+    })
+}
+
 /// Reads and parses an SVG file.
 pub fn load_svg(path: &Path) -> Result<usvg::Tree> {
     let data = read_file(path)?;

@@ -281,7 +281,13 @@ fn run_trace(args: TraceArgs, quiet: bool) -> Result<(), Failure> {
         return Err(Failure::Usage("--resolution must be at least 1 px".into()));
     }
     let job = |inp: &Path| -> Result<String, Error> {
-        Ok(trace::trace_file(inp, &input, &opts)?.to_svg())
+        let doc = trace::trace_file(inp, &input, &opts)?;
+        if !quiet {
+            for w in &doc.warnings {
+                eprintln!("flourish: warning: {}: {w}", inp.display());
+            }
+        }
+        Ok(doc.to_svg())
     };
     run_batch(&args.inputs, &args.out, quiet, &job)
 }

@@ -140,6 +140,9 @@ pub struct Document {
     pub groups: Vec<Group>,
     /// Decimals written for coordinates (see [`decimals_for`]).
     pub decimals: u32,
+    /// What the input held that the document leaves out, one line each
+    /// (not written to the SVG; the command line prints them).
+    pub warnings: Vec<String>,
 }
 
 /// The number of decimals needed so that rounding moves a point by at most a
@@ -161,6 +164,7 @@ impl Document {
             view_box: Rect::new(0.0, 0.0, width, height),
             groups: Vec::new(),
             decimals,
+            warnings: Vec::new(),
         }
     }
 

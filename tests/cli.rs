@@ -501,6 +501,42 @@ fn light_ink_drawings_are_traced_in_their_colour() {
     }
 }
 
+/// Text is not traced (no fonts are read): the shapes still are, and the
+/// designer is told why the lettering is missing, unless `--quiet`; text
+/// kept in `<defs>` is not drawn and draws no warning.
+#[test]
+fn svg_text_is_reported_as_left_out() {
+    let t = tempdir();
+    let drawn = t.path().join("label.svg");
+    std::fs::write(
+        &drawn,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="100" height="50"><rect x="5" y="5" width="20" height="20"/><text x="40" y="30">Label</text></svg>"#,
+    )
+    .unwrap();
+    let kept = t.path().join("defs.svg");
+    std::fs::write(
+        &kept,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="100" height="50"><defs><text id="t">Label</text></defs><rect x="5" y="5" width="20" height="20"/></svg>"#,
+    )
+    .unwrap();
+    let out = t.path().join("out.svg");
+    let o = flourish(&["trace", s(&drawn), "-o", s(&out)]);
+    assert_eq!(code(&o), Some(0), "stderr: {}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("label.svg") && err.contains("text") && err.contains("paths"),
+        "{err}"
+    );
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(std::fs::read_to_string(&out).unwrap().contains("<path"));
+    let o = flourish(&["trace", "-q", s(&drawn), "-o", s(&out)]);
+    assert_eq!(code(&o), Some(0));
+    assert!(stderr(&o).is_empty(), "{}", stderr(&o));
+    let o = flourish(&["trace", s(&kept), "-o", s(&out)]);
+    assert_eq!(code(&o), Some(0));
+    assert!(!stderr(&o).contains("text"), "{}", stderr(&o));
+}
+
 #[test]
 fn transparent_image_gives_valid_empty_svg() {
     let t = tempdir();

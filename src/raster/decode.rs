@@ -88,6 +88,7 @@ impl RasterCoverage {
             width: w as f64,
             height: h as f64,
             layers,
+            warnings: Vec::new(),
         }
     }
 }

@@ -66,6 +66,8 @@ pub struct Ink {
     pub height: f64,
     /// Layers, bottom first.
     pub layers: Vec<InkLayer>,
+    /// What the input held that is not ink here, one line each.
+    pub warnings: Vec<String>,
 }
 
 /// Reads `path` (raster or SVG, told apart by content) as ink.
@@ -509,7 +511,12 @@ fn overlaps(a: kurbo::Rect, b: kurbo::Rect) -> bool {
 
 fn load_svg(path: &Path, bytes: &[u8], opts: &InputOptions) -> Result<Ink> {
     let tree = io::parse_svg(path, bytes)?;
-    svg_ink(path, &tree, opts, None)
+    let mut ink = svg_ink(path, &tree, opts, None)?;
+    if io::svg_has_text(bytes) {
+        ink.warnings
+            .push("its text is left out (no fonts are read): convert text to paths first".into());
+    }
+    Ok(ink)
 }
 
 /// The ink of a parsed SVG `tree` (read from `path`, named in errors) as
@@ -584,5 +591,6 @@ pub fn svg_ink(
         width: uw,
         height: uh,
         layers,
+        warnings: Vec::new(),
     })
 }

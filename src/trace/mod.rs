@@ -318,6 +318,7 @@ pub fn trace_ink(ink: &Ink, opts: &TraceOptions) -> Result<Document> {
         doc.groups
             .extend(layer_group(i, trace_sdf(&layer.sdf, opts), layer.color));
     }
+    doc.warnings = ink.warnings.clone();
     Ok(doc)
 }
 
