@@ -4,6 +4,7 @@
 
 use crate::error::{Error, Result};
 use resvg::usvg;
+use std::borrow::Cow;
 use std::io::Write as _;
 use std::path::Path;
 
@@ -67,9 +68,40 @@ pub fn svg_options() -> usvg::Options<'static> {
     }
 }
 
-/// Parses SVG bytes with [`svg_options`]; `path` names the file in errors.
+/// SVG bytes as plain text bytes: SVGZ (gzip) inflated, refusing more
+/// than [`MAX_FILE_BYTES`] once inflated (a small file can inflate a
+/// thousandfold); plain SVG as it is. `path` names the file in errors.
+pub fn inflate_svgz<'a>(path: &Path, data: &'a [u8]) -> Result<Cow<'a, [u8]>> {
+    inflate_capped(path, data, MAX_FILE_BYTES)
+}
+
+fn inflate_capped<'a>(path: &Path, data: &'a [u8], cap: u64) -> Result<Cow<'a, [u8]>> {
+    use std::io::Read as _;
+    if !data.starts_with(&[0x1f, 0x8b]) {
+        return Ok(Cow::Borrowed(data));
+    }
+    let mut out = Vec::new();
+    flate2::read::GzDecoder::new(data)
+        .take(cap + 1)
+        .read_to_end(&mut out)
+        .map_err(|e| Error::Svg {
+            path: path.to_path_buf(),
+            reason: format!("SVGZ does not inflate: {e}"),
+        })?;
+    if out.len() as u64 > cap {
+        return Err(Error::invalid(
+            path,
+            format!("SVGZ inflates to more than the limit of {cap} bytes"),
+        ));
+    }
+    Ok(Cow::Owned(out))
+}
+
+/// Parses SVG bytes (plain or SVGZ, see [`inflate_svgz`]) with
+/// [`svg_options`]; `path` names the file in errors.
 pub fn parse_svg(path: &Path, data: &[u8]) -> Result<usvg::Tree> {
-    let tree = usvg::Tree::from_data(data, &svg_options()).map_err(|e| Error::Svg {
+    let data = inflate_svgz(path, data)?;
+    let tree = usvg::Tree::from_data(&data, &svg_options()).map_err(|e| Error::Svg {
         path: path.to_path_buf(),
         reason: e.to_string(),
     })?;
@@ -84,7 +116,10 @@ pub fn parse_svg(path: &Path, data: &[u8]) -> Result<usvg::Tree> {
 /// read, so callers can say it is missing. Text inside `<defs>` (drawn
 /// only where used) is not counted.
 pub fn svg_has_text(data: &[u8]) -> bool {
-    let Ok(text) = std::str::from_utf8(data) else {
+    let Ok(data) = inflate_svgz(Path::new(""), data) else {
+        return false;
+    };
+    let Ok(text) = std::str::from_utf8(&data) else {
         return false;
     };
     if !text.contains("text") {
@@ -166,5 +201,43 @@ pub fn same_file(a: &Path, b: &Path) -> bool {
     match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
         (Ok(x), Ok(y)) => x == y,
         _ => a == b,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn gzip(data: &[u8]) -> Vec<u8> {
+        let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
+        enc.write_all(data).expect("compresses");
+        enc.finish().expect("compresses")
+    }
+
+    /// SVGZ inflates to the SVG it holds, plain SVG passes as it is, and
+    /// what inflates past the cap (a small file of zeros) or is not gzip
+    /// after its magic is refused with the file named.
+    #[test]
+    fn svgz_inflates_within_its_cap() {
+        let path = Path::new("art.svgz");
+        let svg = br#"<svg xmlns="http://www.w3.org/2000/svg" width="10" height="10"/>"#;
+        assert_eq!(
+            &*inflate_capped(path, &gzip(svg), 1000).expect("inflates"),
+            svg
+        );
+        assert!(matches!(
+            inflate_capped(path, svg, 1).expect("plain"),
+            Cow::Borrowed(_)
+        ));
+        let bomb = gzip(&vec![0u8; 100_000]);
+        assert!(bomb.len() < 1000);
+        let e = inflate_capped(path, &bomb, 10_000).expect_err("over the cap");
+        assert!(
+            e.to_string().contains("art.svgz") && e.to_string().contains("limit"),
+            "{e}"
+        );
+        let e = inflate_capped(path, &[0x1f, 0x8b, 1, 2, 3], 1000).expect_err("not gzip");
+        assert!(e.to_string().contains("art.svgz"), "{e}");
+        assert!(parse_svg(path, &gzip(svg)).is_ok());
     }
 }

@@ -95,6 +95,7 @@ pub fn load(path: &Path) -> Result<Sketch> {
 
 /// Parses sketch SVG bytes; `path` names the file in errors.
 pub fn parse(path: &Path, data: &[u8]) -> Result<Sketch> {
+    let data = &*io::inflate_svgz(path, data)?;
     let text = std::str::from_utf8(data).map_err(|_| Error::Svg {
         path: path.to_path_buf(),
         reason: "not UTF-8 text".into(),

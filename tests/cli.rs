@@ -537,6 +537,28 @@ fn svg_text_is_reported_as_left_out() {
     assert!(!stderr(&o).contains("text"), "{}", stderr(&o));
 }
 
+/// Inkscape's compressed SVG (SVGZ) traces exactly as the SVG it holds.
+#[test]
+fn svgz_traces_as_its_svg() {
+    use std::io::Write as _;
+    let t = tempdir();
+    let svg = r##"<svg xmlns="http://www.w3.org/2000/svg" width="60" height="40"><circle cx="20" cy="20" r="12" fill="#246"/><path d="M35 30 L55 10" stroke="#000" stroke-width="3"/></svg>"##;
+    let plain = t.path().join("art.svg");
+    std::fs::write(&plain, svg).unwrap();
+    let zipped = t.path().join("art.svgz");
+    let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
+    enc.write_all(svg.as_bytes()).unwrap();
+    std::fs::write(&zipped, enc.finish().unwrap()).unwrap();
+    let (a, b) = (t.path().join("a.svg"), t.path().join("b.svg"));
+    for (inp, out) in [(&plain, &a), (&zipped, &b)] {
+        let o = flourish(&["trace", s(inp), "-o", s(out)]);
+        assert_eq!(code(&o), Some(0), "stderr: {}", stderr(&o));
+    }
+    let (a, b) = (std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+    assert!(String::from_utf8_lossy(&a).contains("<path"));
+    assert_eq!(a, b);
+}
+
 #[test]
 fn transparent_image_gives_valid_empty_svg() {
     let t = tempdir();
