@@ -559,6 +559,39 @@ fn svgz_traces_as_its_svg() {
     assert_eq!(a, b);
 }
 
+/// A photo stored sideways with an Exif orientation (as phones store
+/// them) is traced as it displays: a 40×20 PNG inked on its left half and
+/// marked "turn 90° clockwise" traces to a 20×40 document inked on top.
+#[test]
+fn exif_orientation_is_applied() {
+    use image::ImageEncoder as _;
+    let t = tempdir();
+    let p = t.path().join("sideways.png");
+    let img = image::GrayImage::from_fn(40, 20, |x, _| image::Luma([if x < 20 { 0 } else { 255 }]));
+    // Big-endian TIFF header, one IFD entry: Orientation (0x0112), SHORT,
+    // count 1, value 6 (rotate 90° clockwise to display).
+    let exif = vec![
+        b'M', b'M', 0, 42, 0, 0, 0, 8, 0, 1, 0x01, 0x12, 0, 3, 0, 0, 0, 1, 0, 6, 0, 0, 0, 0, 0, 0,
+    ];
+    let mut png = Vec::new();
+    let mut enc = image::codecs::png::PngEncoder::new(&mut png);
+    enc.set_exif_metadata(exif).expect("PNG takes Exif");
+    enc.write_image(img.as_raw(), 40, 20, image::ExtendedColorType::L8)
+        .expect("encodes");
+    std::fs::write(&p, &png).unwrap();
+    let out = t.path().join("upright.svg");
+    let o = flourish(&["trace", s(&p), "-o", s(&out)]);
+    assert_eq!(code(&o), Some(0), "stderr: {}", stderr(&o));
+    let tree = parse_output(&std::fs::read(&out).unwrap()).expect("parses");
+    assert_eq!((tree.size().width(), tree.size().height()), (20.0, 40.0));
+    let bb = tree.root().abs_bounding_box();
+    assert!(
+        bb.top() < 0.5 && bb.bottom() > 19.5 && bb.bottom() < 20.5,
+        "{bb:?}"
+    );
+    assert!(bb.left() < 0.5 && bb.right() > 19.5, "{bb:?}");
+}
+
 #[test]
 fn transparent_image_gives_valid_empty_svg() {
     let t = tempdir();

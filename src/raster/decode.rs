@@ -13,7 +13,8 @@ use kurbo::Affine;
 use rayon::prelude::*;
 use std::path::Path;
 
-/// Decodes raster bytes, refusing oversized images before decoding.
+/// Decodes raster bytes, refusing oversized images before decoding, and
+/// turns the picture as its Exif orientation says (as viewers show it).
 pub fn decode_raster(path: &Path, bytes: &[u8]) -> Result<image::DynamicImage> {
     let bad = |e: &dyn std::fmt::Display| Error::Image {
         path: path.to_path_buf(),
@@ -38,7 +39,14 @@ pub fn decode_raster(path: &Path, bytes: &[u8]) -> Result<image::DynamicImage> {
     limits.max_image_height = Some(io::MAX_SIDE as u32);
     limits.max_alloc = Some(io::MAX_PIXELS * 8);
     reader.limits(limits);
-    reader.decode().map_err(|e| bad(&e))
+    // Turned as it displays: a phone photo of a sketch is stored sideways
+    // with an Exif orientation that viewers apply.
+    let mut decoder = reader.into_decoder().map_err(|e| bad(&e))?;
+    let orientation = image::ImageDecoder::orientation(&mut decoder)
+        .unwrap_or(image::metadata::Orientation::NoTransforms);
+    let mut img = image::DynamicImage::from_decoder(decoder).map_err(|e| bad(&e))?;
+    img.apply_orientation(orientation);
+    Ok(img)
 }
 
 /// A decoded raster's ink coverage, before any SDF is built.
