@@ -169,7 +169,9 @@ fn anti_aliased_samples_stay_level_with_potrace() {
         "ornament-rosette.png",
         "ornament-scroll.png",
         "thin-lines.png",
-        "two-colour.png",
+        // Not two-colour.png: flourish traces every ink of a picture in
+        // several (the light gold disc too), potrace's threshold only the
+        // dark ones, so the two trace different shapes.
     ];
     for name in samples {
         let c = compare(name, 1);

@@ -221,6 +221,44 @@ fn colour_layers_stack_back_into_the_picture() {
     assert!(frac >= 0.98, "only {frac:.4} of pixels keep their colour");
 }
 
+/// Without `--layers`, a picture in several inks traces to the silhouette
+/// of all of them, as its SVG does (every shape, filled black): the light
+/// gold disc of the two-colour sample is not lost to the one-half
+/// darkness threshold. The raster's and the vector's traces render alike.
+#[test]
+fn all_inks_trace_to_one_silhouette_as_the_svg_does() {
+    let render_trace = |name: &str| -> Vec<bool> {
+        let path = root().join("samples/trace").join(name);
+        let input = InputOptions {
+            resolution: 512,
+            ..InputOptions::default()
+        };
+        let doc = trace_file(&path, &input, &TraceOptions::default()).expect("traces");
+        assert!(
+            doc.groups
+                .iter()
+                .flat_map(|g| &g.shapes)
+                .all(|s| s.fill == Some(flourish::svg_out::Color::BLACK)),
+            "{name}: mixed inks are filled black"
+        );
+        let svg = doc.to_svg();
+        let tree = io::parse_svg(&path, svg.as_bytes()).expect("parses");
+        let pix = render::render_tree(&path, &tree, Some(512), Some([255, 255, 255, 255]))
+            .expect("renders");
+        pix.data().chunks(4).map(|p| p[0] < 128).collect()
+    };
+    let (raster, vector) = (
+        render_trace("two-colour.png"),
+        render_trace("two-colour.svg"),
+    );
+    let score = iou(&raster, &vector);
+    assert!(score >= 0.99, "raster vs vector silhouette IoU {score:.4}");
+    // The disc (gold, darkness about 0.35) is in it: the centre row is
+    // inked from the disc's left edge to its right.
+    let row = &raster[256 * 512..257 * 512];
+    assert!(row[120..392].iter().all(|&b| b), "the gold disc is traced");
+}
+
 /// The same input gives byte-identical SVG on one thread and on two.
 #[test]
 fn output_does_not_depend_on_thread_count() {

@@ -132,7 +132,7 @@ pub(super) fn pixel_coverage(
         RasterCoverage::Layers {
             w,
             h,
-            layers: quantized_layers(px, w, h, has_alpha, opts.invert),
+            layers: quantized_layers(px, w, h, has_alpha, opts.invert, false),
         }
     } else {
         // Raw coverage (alpha, or darkness on an opaque image), then put on
@@ -147,10 +147,26 @@ pub(super) fn pixel_coverage(
                 }
             })
             .collect();
-        let mut scale = InkScale::of_values(&raw);
+        let scale = InkScale::of_values(&raw);
         if !has_alpha && !one_ink(px, &raw, scale) {
-            // Several inks: each is read by its own darkness, as it is.
-            scale = InkScale::RAW;
+            // Several inks: all of them, however light, each pixel read as
+            // its mix of an ink or two and the paper (the bottom layer of
+            // `--layers`' stack), filled black.
+            if let Some((_, all)) = quantized_layers(px, w, h, false, false, true)
+                .into_iter()
+                .next()
+            {
+                let cov = if opts.invert {
+                    all.map(|c| 1.0 - c)
+                } else {
+                    all
+                };
+                return RasterCoverage::Layers {
+                    w,
+                    h,
+                    layers: vec![(Color::BLACK, cov)],
+                };
+            }
         }
         let cov = Grid::from_vec(
             w,
@@ -279,8 +295,8 @@ const INK_OUTLIERS: f64 = 0.001;
 /// in yellow or light-grey ink traces as a drawing (its strokes' raw
 /// darkness, 0.2–0.4, is under one half), its anti-aliased edges at their
 /// true share, and black ink on white paper (paper 0, ink 1) exactly as
-/// the raw value. Several inks of different darkness are measured against
-/// the darkest (`--layers` traces each colour on its own).
+/// the raw value. A picture in several inks is not put on one scale (see
+/// [`one_ink`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct InkScale {
     /// Raw coverage of the paper: the most common level under
@@ -375,8 +391,8 @@ const MIX_TOLERANCE: f32 = 0.1;
 /// a small drawing's off the line) lie farther than [`MIX_TOLERANCE`] from the
 /// RGB segment between the paper's and the ink's mean colours. Only then
 /// is the image's coverage put on [`InkScale`]; a drawing in several inks
-/// keeps each pixel's own darkness (its lighter inks are not measured
-/// against the darkest).
+/// is read through its palette instead (the union of all inks, so its
+/// lighter inks are not measured against the darkest).
 fn one_ink(px: &[[u8; 4]], raw: &[f32], scale: InkScale) -> bool {
     if scale == InkScale::RAW {
         return true;
@@ -451,6 +467,7 @@ fn quantized_layers(
     h: usize,
     has_alpha: bool,
     invert: bool,
+    union_only: bool,
 ) -> Vec<(Color, Coverage)> {
     // Composite over white so transparency reads as paper.
     let rgb: Vec<[f32; 3]> = px
@@ -465,7 +482,8 @@ fn quantized_layers(
     let keys: Vec<u32> = rgb.iter().map(key).collect();
     // Per colour bin: pixels, pixels inside a patch of the colour (their
     // four neighbours in the same bin), and the sum of the colours.
-    let mut hist = std::collections::BTreeMap::<u32, (u64, u64, [f64; 3])>::new();
+    // (Keys are 12 bits: one slot per key, visited in key order.)
+    let mut hist = vec![(0u64, 0u64, [0f64; 3]); 1 << 12];
     for (i, c) in rgb.iter().enumerate() {
         let (x, y) = (i % w, i / w);
         let k = keys[i];
@@ -474,7 +492,9 @@ fn quantized_layers(
             && x + 1 < w
             && y + 1 < h
             && [i - 1, i + 1, i - w, i + w].iter().all(|&j| keys[j] == k);
-        let e = hist.entry(k).or_insert((0, 0, [0.0; 3]));
+        let Some(e) = hist.get_mut(k as usize) else {
+            continue;
+        };
         e.0 += 1;
         e.1 += u64::from(interior);
         for (sum, &v) in e.2.iter_mut().zip(c) {
@@ -486,8 +506,8 @@ fn quantized_layers(
     // ink: a palette colour must fill patches of its own.
     let min_interior = ((w * h) as u64 / 2000).max(1);
     let mut bins: Vec<(u64, [f32; 3])> = hist
-        .values()
-        .filter(|(_, interior, _)| *interior >= min_interior)
+        .iter()
+        .filter(|(n, interior, _)| *n > 0 && *interior >= min_interior)
         .map(|(n, _, s)| (*n, [0, 1, 2].map(|k| (s[k] / *n as f64) as f32)))
         .collect();
     bins.sort_by(|a, b| {
@@ -506,17 +526,21 @@ fn quantized_layers(
         }
     }
     // Paper: the most common colour on the border (white if none).
-    let mut border = std::collections::BTreeMap::<u32, usize>::new();
+    let mut border = vec![0usize; 1 << 12];
     for (i, c) in rgb.iter().enumerate() {
         let (x, y) = (i % w, i / w);
         if x == 0 || y == 0 || x + 1 == w || y + 1 == h {
-            *border.entry(key(c)).or_default() += 1;
+            if let Some(n) = border.get_mut(key(c) as usize) {
+                *n += 1;
+            }
         }
     }
     let paper_key = border
         .iter()
-        .max_by_key(|(k, n)| (**n, std::cmp::Reverse(**k)))
-        .map(|(k, _)| *k);
+        .enumerate()
+        .filter(|(_, &n)| n > 0)
+        .max_by_key(|(k, &n)| (n, std::cmp::Reverse(*k)))
+        .map(|(k, _)| k as u32);
     let paper = palette
         .iter()
         .position(|p| Some(key(p)) == paper_key)
@@ -535,15 +559,27 @@ fn quantized_layers(
         palette.truncate(1);
     }
     let k = palette.len();
-    // Per pixel, weights of its two nearest palette colours.
+    // Per pixel, weights of its two nearest palette colours (pixels in
+    // parallel: each writes its own `k` weights).
+    // The pairs (a ≤ b) with their difference and its squared length,
+    // computed once.
+    let pairs: Vec<(usize, usize, [f32; 3], f32)> = (0..k)
+        .flat_map(|a| (a..k).map(move |b| (a, b)))
+        .map(|(a, b)| {
+            let (pa, pb) = (&palette[a], &palette[b]);
+            let d = [0, 1, 2].map(|j| pa[j] - pb[j]);
+            let dd: f32 = d.iter().map(|v| v * v).sum();
+            (a, b, d, dd)
+        })
+        .collect();
     let mut weights = vec![0f32; w * h * k];
-    for (i, c) in rgb.iter().enumerate() {
-        let mut best = (f32::MAX, 0usize, 0usize, 1.0f32);
-        for a in 0..k {
-            for b in a..k {
-                let (pa, pb) = (&palette[a], &palette[b]);
-                let d = [0, 1, 2].map(|j| pa[j] - pb[j]);
-                let dd: f32 = d.iter().map(|v| v * v).sum();
+    weights
+        .par_chunks_mut(k.max(1))
+        .zip(rgb.par_iter())
+        .for_each(|(wt, c)| {
+            let mut best = (f32::MAX, 0usize, 0usize, 1.0f32);
+            for &(a, b, d, dd) in &pairs {
+                let pb = &palette[b];
                 let t = if dd > 0.0 {
                     (((0..3).map(|j| (c[j] - pb[j]) * d[j]).sum::<f32>()) / dd).clamp(0.0, 1.0)
                 } else {
@@ -555,15 +591,32 @@ fn quantized_layers(
                     best = (e, a, b, t);
                 }
             }
-        }
-        let (_, a, b, t) = best;
-        weights[i * k + a] += t;
-        weights[i * k + b] += 1.0 - t;
-    }
+            let (_, a, b, t) = best;
+            if let Some(x) = wt.get_mut(a) {
+                *x += t;
+            }
+            if let Some(x) = wt.get_mut(b) {
+                *x += 1.0 - t;
+            }
+        });
     if invert {
         let cov = Grid::from_fn(w, h, |x, y| weights[(y * w + x) * k]);
         let c = palette[0];
         return vec![(Color::rgb(c[0] as u8, c[1] as u8, c[2] as u8), cov)];
+    }
+    if union_only {
+        // Only the bottom of the stack (every ink), black; nothing when the
+        // palette holds no ink.
+        if k < 2 {
+            return Vec::new();
+        }
+        let all: Vec<f32> = weights
+            .par_chunks(k)
+            .map(|wt| wt.iter().skip(1).sum::<f32>().min(1.0))
+            .collect();
+        return Grid::from_vec(w, h, all)
+            .map(|g| vec![(Color::BLACK, g)])
+            .unwrap_or_default();
     }
     // Stack by area, largest at the bottom.
     let mut order: Vec<usize> = (1..k).collect();
@@ -695,7 +748,7 @@ mod tests {
                 })
                 .collect()
         };
-        let layers = quantized_layers(&picture(false), w, h, false, false);
+        let layers = quantized_layers(&picture(false), w, h, false, false, false);
         assert_eq!(
             layers.len(),
             1,
@@ -703,7 +756,7 @@ mod tests {
             layers.iter().map(|l| l.0).collect::<Vec<_>>()
         );
         assert!(layers[0].0 == Color::rgb(0, 0, 0), "{:?}", layers[0].0);
-        let layers = quantized_layers(&picture(true), w, h, false, false);
+        let layers = quantized_layers(&picture(true), w, h, false, false, false);
         assert_eq!(layers.len(), 2);
     }
 
@@ -737,9 +790,9 @@ mod tests {
     }
 
     /// A drawing in one light ink traces as a drawing, in its colour; two
-    /// inks keep each pixel's own darkness.
+    /// inks are told apart from one.
     #[test]
-    fn one_light_ink_is_traced_and_two_inks_are_read_as_they_are() {
+    fn one_light_ink_is_traced_and_two_inks_are_told_apart() {
         let (w, h) = (64usize, 48usize);
         let picture = |second: bool| -> Vec<[u8; 4]> {
             (0..w * h)
