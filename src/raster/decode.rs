@@ -572,31 +572,48 @@ fn quantized_layers(
             (a, b, d, dd)
         })
         .collect();
+    let nearest_mix = |c: &[f32; 3]| {
+        let mut best = (f32::MAX, 0usize, 0usize, 1.0f32);
+        for &(a, b, d, dd) in &pairs {
+            let pb = &palette[b];
+            let t = if dd > 0.0 {
+                (((0..3).map(|j| (c[j] - pb[j]) * d[j]).sum::<f32>()) / dd).clamp(0.0, 1.0)
+            } else {
+                1.0
+            };
+            let mix = [0, 1, 2].map(|j| pb[j] + t * d[j]);
+            let e = dist2(&mix, c);
+            if e < best.0 {
+                best = (e, a, b, t);
+            }
+        }
+        (best.1, best.2, best.3)
+    };
+    // A pixel with the value of the one before it in its row takes that
+    // one's mix (flat art is long runs of one value); rows in parallel.
+    let value = |p: &[u8; 4]| u32::from_le_bytes(*p);
     let mut weights = vec![0f32; w * h * k];
     weights
-        .par_chunks_mut(k.max(1))
-        .zip(rgb.par_iter())
-        .for_each(|(wt, c)| {
-            let mut best = (f32::MAX, 0usize, 0usize, 1.0f32);
-            for &(a, b, d, dd) in &pairs {
-                let pb = &palette[b];
-                let t = if dd > 0.0 {
-                    (((0..3).map(|j| (c[j] - pb[j]) * d[j]).sum::<f32>()) / dd).clamp(0.0, 1.0)
-                } else {
-                    1.0
+        .par_chunks_mut((k * w).max(1))
+        .zip(px.par_chunks(w.max(1)).zip(rgb.par_chunks(w.max(1))))
+        .for_each(|(row, (prow, crow))| {
+            let mut last: Option<(u32, (usize, usize, f32))> = None;
+            for ((wt, p), c) in row.chunks_mut(k.max(1)).zip(prow).zip(crow) {
+                let v = value(p);
+                let (a, b, t) = match last {
+                    Some((lv, mix)) if lv == v => mix,
+                    _ => {
+                        let mix = nearest_mix(c);
+                        last = Some((v, mix));
+                        mix
+                    }
                 };
-                let mix = [0, 1, 2].map(|j| pb[j] + t * d[j]);
-                let e = dist2(&mix, c);
-                if e < best.0 {
-                    best = (e, a, b, t);
+                if let Some(x) = wt.get_mut(a) {
+                    *x += t;
                 }
-            }
-            let (_, a, b, t) = best;
-            if let Some(x) = wt.get_mut(a) {
-                *x += t;
-            }
-            if let Some(x) = wt.get_mut(b) {
-                *x += 1.0 - t;
+                if let Some(x) = wt.get_mut(b) {
+                    *x += 1.0 - t;
+                }
             }
         });
     if invert {
