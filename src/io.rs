@@ -112,29 +112,26 @@ pub fn parse_svg(path: &Path, data: &[u8]) -> Result<usvg::Tree> {
     Ok(tree)
 }
 
-/// Whether SVG data draws `<text>`: usvg drops text, as no fonts are
-/// read, so callers can say it is missing. Text inside `<defs>` (drawn
-/// only where used) is not counted.
-pub fn svg_has_text(data: &[u8]) -> bool {
-    let Ok(data) = inflate_svgz(Path::new(""), data) else {
-        return false;
-    };
-    let Ok(text) = std::str::from_utf8(&data) else {
-        return false;
-    };
+/// The warning for plain SVG data (already inflated, see
+/// [`inflate_svgz`]) that draws `<text>`: usvg drops text, as no fonts are
+/// read, so callers say it is missing. Text inside `<defs>` (drawn only
+/// where used) is not counted.
+pub fn text_left_out(data: &[u8]) -> Option<&'static str> {
+    let text = std::str::from_utf8(data).ok()?;
     if !text.contains("text") {
-        return false;
+        return None;
     }
     let opts = usvg::roxmltree::ParsingOptions {
         allow_dtd: true,
         ..Default::default()
     };
     const SVG: &str = "http://www.w3.org/2000/svg";
-    usvg::roxmltree::Document::parse_with_options(text, opts).is_ok_and(|doc| {
+    let drawn = usvg::roxmltree::Document::parse_with_options(text, opts).is_ok_and(|doc| {
         doc.descendants().any(|n| {
             n.has_tag_name((SVG, "text")) && !n.ancestors().any(|a| a.has_tag_name((SVG, "defs")))
         })
-    })
+    });
+    drawn.then_some("its text is left out (no fonts are read): convert text to paths first")
 }
 
 /// Reads and parses an SVG file.

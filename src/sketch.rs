@@ -118,11 +118,9 @@ pub fn parse(path: &Path, data: &[u8]) -> Result<Sketch> {
         warnings: Vec::new(),
     };
     walk(tree.root(), to_user, &pre.styles, &mut sketch);
-    if io::svg_has_text(data) {
-        sketch
-            .warnings
-            .push("its text is left out (no fonts are read): convert text to paths first".into());
-    }
+    sketch
+        .warnings
+        .extend(io::text_left_out(data).map(String::from));
     Ok(sketch)
 }
 

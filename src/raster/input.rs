@@ -510,12 +510,12 @@ fn overlaps(a: kurbo::Rect, b: kurbo::Rect) -> bool {
 }
 
 fn load_svg(path: &Path, bytes: &[u8], opts: &InputOptions) -> Result<Ink> {
-    let tree = io::parse_svg(path, bytes)?;
+    // Inflated once for both the tree and the text check.
+    let bytes = io::inflate_svgz(path, bytes)?;
+    let tree = io::parse_svg(path, &bytes)?;
     let mut ink = svg_ink(path, &tree, opts, None)?;
-    if io::svg_has_text(bytes) {
-        ink.warnings
-            .push("its text is left out (no fonts are read): convert text to paths first".into());
-    }
+    ink.warnings
+        .extend(io::text_left_out(&bytes).map(String::from));
     Ok(ink)
 }
 
