@@ -4,6 +4,7 @@
 //! [`Bitmap`]), or colours quantized into layers.
 
 use super::input::{Ink, InkLayer, InputOptions};
+use super::lighting::Lighting;
 use super::paths::Bitmap;
 use super::{Coverage, Grid, Sdf};
 use crate::error::{Error, Result};
@@ -110,11 +111,29 @@ pub(super) fn raster_coverage(
 ) -> Result<RasterCoverage> {
     let img = decode_raster(path, bytes)?;
     if let (image::DynamicImage::ImageLuma8(grey), false) = (&img, opts.layers) {
+        let (w, h) = (grey.width() as usize, grey.height() as usize);
+        // A photo's uneven light divided out first (see `lighting`).
+        let raw = grey.as_raw();
+        let luma = |x: usize, y: usize| raw.get(y * w + x).copied().unwrap_or(255);
+        if let Some(light) = Lighting::measure(w, h, luma) {
+            let mut even = grey.clone();
+            light.flatten_grey(&mut even);
+            return Ok(grey_coverage(&even, opts.invert));
+        }
         return Ok(grey_coverage(grey, opts.invert));
     }
     let img = img.to_rgba8();
     let (w, h) = (img.width() as usize, img.height() as usize);
-    let px: Vec<[u8; 4]> = img.pixels().map(|p| p.0).collect();
+    let mut px: Vec<[u8; 4]> = img.pixels().map(|p| p.0).collect();
+    if px.iter().all(|p| p[3] == 255) {
+        let at = |x: usize, y: usize| {
+            px.get(y * w + x)
+                .map_or(255, |p| (luma(p) * 255.0).round() as u8)
+        };
+        if let Some(light) = Lighting::measure(w, h, at) {
+            light.flatten_rgba(&mut px);
+        }
+    }
     Ok(pixel_coverage(&px, w, h, opts))
 }
 

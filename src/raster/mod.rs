@@ -8,6 +8,7 @@ pub mod cull;
 mod decode;
 pub mod edt;
 pub mod input;
+pub mod lighting;
 mod line_ends;
 pub mod paths;
 pub mod plain;

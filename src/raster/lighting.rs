@@ -1,0 +1,352 @@
+//! Uneven lighting of a photographed sketch, measured and divided out
+//! before the ink is read (by the raster decoder, `raster::decode`).
+//!
+//! A phone photo of a drawing is brighter where the lamp was and falls off
+//! towards the corners: the paper in a dim corner can be darker than one
+//! half, and one threshold over the whole picture fills that corner with
+//! ink. What the camera sees is the paper's and the ink's reflectance times
+//! the light falling there, so the light is a smooth surface that divides
+//! out. It is measured where the paper shows: the picture is cut into
+//! blocks, each block's paper is its brightest tenth (ink covers less than
+//! nine tenths of nearly every block of a line drawing), and a smooth
+//! surface (a cubic polynomial in x and y) is fitted to the blocks by least
+//! squares, dropping the blocks that lie well below it (blocks filled with
+//! ink) and fitting again until none changes. This is the background
+//! estimation of document binarization (a smooth surface fitted to the
+//! background's samples, as in Lu, Su and Tan 2010 for degraded documents;
+//! a polynomial surface, as photometric flat-fielding uses for vignetting).
+//!
+//! Evenly lit pictures (scans, renders: every sample the project ships)
+//! are left exactly as they are: the surface is used only when it varies
+//! by more than [`UNEVEN`] of the full scale over the picture.
+
+use nalgebra::{SMatrix, SVector};
+use rayon::prelude::*;
+
+/// Smallest change of the paper's brightness over the picture (share of
+/// full scale, 13 of 255 grey levels) that is divided out: under it the
+/// ink scale's own paper allowance covers the difference.
+pub const UNEVEN: f64 = 0.05;
+
+/// Share of a block's pixels, brightest first, that is taken for its paper.
+const PAPER_SHARE: f64 = 0.1;
+
+/// How far (share of full scale) a block's paper may lie below the fitted
+/// surface and still count as paper: further down, ink fills the block.
+const BELOW: f64 = 0.06;
+
+/// Blocks across the picture's longer side.
+const BLOCKS: usize = 32;
+
+/// Fewest pixels along a block's side.
+const MIN_BLOCK: usize = 8;
+
+/// Pixels read along a block's side, about (see [`block_paper`]).
+const SAMPLES_ACROSS: usize = 8;
+
+/// Rounds of fitting and dropping blocks, at most.
+const ROUNDS: usize = 12;
+
+/// Terms of the cubic surface: 1, u, v, u², uv, v², u³, u²v, uv², v³.
+const TERMS: usize = 10;
+
+/// The light over a picture, as the paper's brightness (0..=1, relative
+/// luminance) at each point: a cubic polynomial in the picture's
+/// coordinates scaled to −1..=1.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Lighting {
+    width: usize,
+    height: usize,
+    coef: [f64; TERMS],
+    /// The brightest paper over the picture: what all the paper is evened
+    /// out to.
+    brightest: f64,
+    /// The darkest paper over the picture.
+    darkest: f64,
+}
+
+/// The cubic surface's terms at (u, v).
+fn terms(u: f64, v: f64) -> [f64; TERMS] {
+    [
+        1.0,
+        u,
+        v,
+        u * u,
+        u * v,
+        v * v,
+        u * u * u,
+        u * u * v,
+        u * v * v,
+        v * v * v,
+    ]
+}
+
+impl Lighting {
+    /// Measures the light of a `width` × `height` picture from its
+    /// luminance `luma(x, y)` (0 black to 255 white). `None` when the
+    /// picture is evenly lit (the paper varies by less than [`UNEVEN`]),
+    /// too small to cut into blocks, or shows too little paper to fit.
+    pub fn measure(
+        width: usize,
+        height: usize,
+        luma: impl Fn(usize, usize) -> u8 + Sync,
+    ) -> Option<Lighting> {
+        let side = (width.max(height) / BLOCKS).max(MIN_BLOCK);
+        let (bx, by) = (width.div_ceil(side), height.div_ceil(side));
+        if width == 0 || height == 0 || bx * by < 4 * TERMS {
+            return None;
+        }
+        let stride = (side / SAMPLES_ACROSS).max(1);
+        let blocks = block_paper(&luma, width, height, side, stride);
+        // Each block's centre in −1..=1 and its paper level.
+        let to_u = |x: f64, n: usize| 2.0 * x / n as f64 - 1.0;
+        let samples: Vec<([f64; TERMS], f64)> = blocks
+            .iter()
+            .enumerate()
+            .map(|(k, &paper)| {
+                let (i, j) = (k % bx, k / bx);
+                let cx = ((i * side) as f64 + ((i + 1) * side).min(width) as f64) / 2.0;
+                let cy = ((j * side) as f64 + ((j + 1) * side).min(height) as f64) / 2.0;
+                (terms(to_u(cx, width), to_u(cy, height)), paper)
+            })
+            .collect();
+        let mut keep = vec![true; samples.len()];
+        let mut coef = fit(&samples, &keep)?;
+        for _ in 0..ROUNDS {
+            let next: Vec<bool> = samples
+                .iter()
+                .map(|(t, paper)| *paper >= eval(&coef, t) - BELOW)
+                .collect();
+            if next == keep {
+                break;
+            }
+            keep = next;
+            coef = fit(&samples, &keep)?;
+        }
+        // The surface's range over the paper it was fitted to.
+        let (mut darkest, mut brightest) = (f64::INFINITY, f64::NEG_INFINITY);
+        for ((t, _), _) in samples.iter().zip(&keep).filter(|(_, &k)| k) {
+            let s = eval(&coef, t);
+            darkest = darkest.min(s);
+            brightest = brightest.max(s);
+        }
+        let lighting = Lighting {
+            width,
+            height,
+            coef,
+            brightest: brightest.min(1.0),
+            darkest,
+        };
+        (darkest > 0.0 && brightest - darkest >= UNEVEN).then_some(lighting)
+    }
+
+    /// The paper's brightness (0..=1) at the centre of pixel (x, y).
+    pub fn paper_at(&self, x: usize, y: usize) -> f64 {
+        let u = 2.0 * (x as f64 + 0.5) / self.width as f64 - 1.0;
+        let v = 2.0 * (y as f64 + 0.5) / self.height as f64 - 1.0;
+        eval(&self.coef, &terms(u, v))
+    }
+
+    /// The range of the paper's brightness over the picture (0..=1):
+    /// darkest and brightest.
+    pub fn range(&self) -> (f64, f64) {
+        (self.darkest, self.brightest)
+    }
+
+    /// The factor pixel (x, y)'s values are multiplied by to light it as
+    /// the brightest paper is lit.
+    fn gain(&self, x: usize, y: usize) -> f32 {
+        // The fitted surface stays positive over the paper it was fitted
+        // to; between blocks filled with ink it may not, where it is held
+        // to the darkest paper measured.
+        let paper = self.paper_at(x, y).max(self.darkest);
+        (self.brightest / paper) as f32
+    }
+
+    /// Evens out the light of grey pixels (0..=255, row by row) in place.
+    pub fn flatten_grey(&self, grey: &mut [u8]) {
+        let w = self.width.max(1);
+        grey.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+            for (x, v) in row.iter_mut().enumerate() {
+                *v = scaled(*v, self.gain(x, y));
+            }
+        });
+    }
+
+    /// Evens out the light of RGBA pixels (row by row) in place: each
+    /// colour channel times the same gain, so hues stay.
+    pub fn flatten_rgba(&self, px: &mut [[u8; 4]]) {
+        let w = self.width.max(1);
+        px.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+            for (x, p) in row.iter_mut().enumerate() {
+                let g = self.gain(x, y);
+                for c in &mut p[..3] {
+                    *c = scaled(*c, g);
+                }
+            }
+        });
+    }
+}
+
+/// `v` times `gain`, rounded and held to 0..=255.
+fn scaled(v: u8, gain: f32) -> u8 {
+    (f32::from(v) * gain).round().clamp(0.0, 255.0) as u8
+}
+
+/// The surface `coef` at terms `t`.
+fn eval(coef: &[f64; TERMS], t: &[f64; TERMS]) -> f64 {
+    coef.iter().zip(t).map(|(c, t)| c * t).sum()
+}
+
+/// Least squares surface through the kept samples (normal equations,
+/// Cholesky), `None` when too few are kept or they do not fix the surface.
+fn fit(samples: &[([f64; TERMS], f64)], keep: &[bool]) -> Option<[f64; TERMS]> {
+    let mut ata = SMatrix::<f64, TERMS, TERMS>::zeros();
+    let mut atb = SVector::<f64, TERMS>::zeros();
+    let mut n = 0usize;
+    for ((t, paper), _) in samples.iter().zip(keep).filter(|(_, &k)| k) {
+        let t = SVector::<f64, TERMS>::from_column_slice(t);
+        ata += t * t.transpose();
+        atb += t * *paper;
+        n += 1;
+    }
+    if n < 2 * TERMS {
+        return None;
+    }
+    let x = ata.cholesky()?.solve(&atb);
+    let mut coef = [0.0; TERMS];
+    coef.copy_from_slice(x.as_slice());
+    coef.iter().all(|c| c.is_finite()).then_some(coef)
+}
+
+/// Each block's paper (0..=1): the level above which lies the brightest
+/// [`PAPER_SHARE`] of its pixels, read on a lattice of every `stride`th
+/// pixel each way (a few dozen per block: the light changes over many
+/// blocks, and reading every pixel cost 8 % of a 2 Mpx trace). Blocks are
+/// `side` px square (cut short at the right and bottom edges), row by row.
+fn block_paper(
+    luma: &(impl Fn(usize, usize) -> u8 + Sync),
+    width: usize,
+    height: usize,
+    side: usize,
+    stride: usize,
+) -> Vec<f64> {
+    let bx = width.div_ceil(side);
+    let by = height.div_ceil(side);
+    (0..by)
+        .into_par_iter()
+        .flat_map_iter(|j| {
+            let rows = (j * side..((j + 1) * side).min(height)).step_by(stride);
+            (0..bx)
+                .map(|i| {
+                    let mut hist = [0u32; 256];
+                    for y in rows.clone() {
+                        for x in (i * side..((i + 1) * side).min(width)).step_by(stride) {
+                            hist[usize::from(luma(x, y))] += 1;
+                        }
+                    }
+                    let total: u32 = hist.iter().sum();
+                    let wanted = ((f64::from(total) * PAPER_SHARE).ceil() as u32).max(1);
+                    let mut seen = 0u32;
+                    for v in (0..256).rev() {
+                        seen += hist[v];
+                        if seen >= wanted {
+                            return v as f64 / 255.0;
+                        }
+                    }
+                    0.0
+                })
+                .collect::<Vec<f64>>()
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A picture lit by `light` (0..=1 at each pixel) holding white paper
+    /// (240) with dark strokes (30) on a grid of lines and one solid black
+    /// square (ink filling several blocks).
+    fn photo(w: usize, h: usize, light: impl Fn(f64, f64) -> f64) -> Vec<u8> {
+        let mut out = vec![0u8; w * h];
+        for y in 0..h {
+            for x in 0..w {
+                let stroke = x % 37 < 3 || y % 53 < 2;
+                let solid = (100..180).contains(&x) && (60..140).contains(&y);
+                let r = if stroke || solid { 30.0 } else { 240.0 };
+                let l = light(x as f64 / w as f64, y as f64 / h as f64);
+                out[y * w + x] = (r * l).round() as u8;
+            }
+        }
+        out
+    }
+
+    /// Reads pixel (x, y) of a `w`-wide picture.
+    fn at(img: &[u8], w: usize) -> impl Fn(usize, usize) -> u8 + Sync + '_ {
+        move |x, y| img[y * w + x]
+    }
+
+    #[test]
+    fn an_evenly_lit_picture_is_left_alone() {
+        let img = photo(400, 300, |_, _| 1.0);
+        assert_eq!(Lighting::measure(400, 300, at(&img, 400)), None);
+        // A gentle fall-off (3 %) is within the ink scale's allowance.
+        let img = photo(400, 300, |u, _| 1.0 - 0.03 * u);
+        assert_eq!(Lighting::measure(400, 300, at(&img, 400)), None);
+    }
+
+    #[test]
+    fn a_light_falling_off_is_measured_on_the_paper_and_divided_out() {
+        // Light from 1 in the top-left corner to 0.45 in the bottom-right,
+        // curved (as a lamp's fall-off is).
+        let light = |u: f64, v: f64| 1.0 - 0.55 * (0.6 * u + 0.4 * v * v);
+        let (w, h) = (400, 300);
+        let mut img = photo(w, h, light);
+        let l = Lighting::measure(w, h, at(&img, w)).expect("uneven");
+        // The surface follows the paper (240 × light) to 1.5 % everywhere,
+        // the solid square included (its blocks were dropped).
+        for y in (0..h).step_by(7) {
+            for x in (0..w).step_by(7) {
+                let want = 240.0 / 255.0 * light(x as f64 / w as f64, y as f64 / h as f64);
+                let got = l.paper_at(x, y);
+                assert!((got - want).abs() < 0.015, "({x}, {y}): {got} vs {want}");
+            }
+        }
+        // Evened out, paper is paper and ink is ink everywhere: the paper
+        // within 8 levels (3 %) of its level in the light, the ink at least
+        // 150 below it.
+        l.flatten_grey(&mut img);
+        let clean = photo(w, h, |_, _| 1.0);
+        for (k, (&v, &c)) in img.iter().zip(&clean).enumerate() {
+            if c == 240 {
+                assert!(v >= 232, "paper at {k}: {v}");
+            } else {
+                assert!(v <= 90, "ink at {k}: {v}");
+            }
+        }
+    }
+
+    #[test]
+    fn colours_keep_their_hue() {
+        let (w, h) = (200, 200);
+        let luma = photo(w, h, |u, _| 1.0 - 0.5 * u);
+        let l = Lighting::measure(w, h, at(&luma, w)).expect("uneven");
+        let mut px = vec![[100u8, 50, 25, 255]; w * h];
+        l.flatten_rgba(&mut px);
+        for p in &px {
+            // Channels scaled alike: ratios within rounding.
+            let r = f64::from(p[0]);
+            assert!((f64::from(p[1]) - r / 2.0).abs() <= 1.0, "{p:?}");
+            assert!((f64::from(p[2]) - r / 4.0).abs() <= 1.0, "{p:?}");
+            assert_eq!(p[3], 255);
+        }
+    }
+
+    #[test]
+    fn tiny_pictures_are_not_measured() {
+        assert_eq!(Lighting::measure(2, 2, at(&[0, 255, 0, 255], 2)), None);
+        assert_eq!(Lighting::measure(0, 0, |_, _| 255), None);
+        assert_eq!(Lighting::measure(0, 100, |_, _| 255), None);
+    }
+}
