@@ -442,26 +442,34 @@ fn thin_run(cov: &Coverage, x: i32, y: i32, dx: i32, dy: i32) -> Option<(i32, i3
 /// glyph. The walk is kept as the tests' oracle.
 struct ThinRuns {
     width: usize,
-    /// Per pixel: its run along x as steps `(first ≤ 0, last ≥ 0)`, if thin.
-    along_x: Vec<Option<(i8, i8)>>,
+    /// Per pixel: its run along x, if thin, packed by [`ThinRuns::pack`]
+    /// (0 for none: the buffers start zeroed, which the allocator hands out
+    /// untouched, and only the pages holding a thin run are written).
+    along_x: Vec<u8>,
     /// The same along y.
-    along_y: Vec<Option<(i8, i8)>>,
+    along_y: Vec<u8>,
 }
 
 impl ThinRuns {
+    /// A run as steps `(first ≤ 0, last ≥ 0)` from a pixel, at most
+    /// [`THIN_RUN`] long, as one byte: `1 + 3·(−first) + last`.
+    fn pack(first: usize, last: usize) -> u8 {
+        (1 + 3 * first + last) as u8
+    }
+
     fn new(cov: &Coverage) -> Self {
         let (w, h) = (cov.width(), cov.height());
         let inked = |c: f32| c > COVERAGE_EPS;
         // Every maximal run of inked pixels at most THIN_RUN long, given by
         // its first index and length, marks each of its pixels.
-        let mark = |out: &mut dyn FnMut(usize, (i8, i8)), start: usize, len: usize| {
+        let mark = |out: &mut dyn FnMut(usize, u8), start: usize, len: usize| {
             if len as i32 <= THIN_RUN {
                 for k in 0..len {
-                    out(start + k, (-(k as i8), (len - 1 - k) as i8));
+                    out(start + k, Self::pack(k, len - 1 - k));
                 }
             }
         };
-        let mut along_x = vec![None; w * h];
+        let mut along_x = vec![0u8; w * h];
         along_x
             .par_chunks_mut(w.max(1))
             .zip(cov.data().par_chunks(w.max(1)))
@@ -472,7 +480,7 @@ impl ThinRuns {
                     match (ink, start) {
                         (true, None) => start = Some(x),
                         (false, Some(s)) => {
-                            mark(&mut |i, r| out[i] = Some(r), s, x - s);
+                            mark(&mut |i, r| out[i] = r, s, x - s);
                             start = None;
                         }
                         _ => {}
@@ -480,7 +488,7 @@ impl ThinRuns {
                 }
             });
         // Columns: each column's open run carried down the rows.
-        let mut along_y = vec![None; w * h];
+        let mut along_y = vec![0u8; w * h];
         let mut start: Vec<Option<usize>> = vec![None; w];
         for y in 0..=h {
             for (x, st) in start.iter_mut().enumerate() {
@@ -488,7 +496,7 @@ impl ThinRuns {
                 match (ink, *st) {
                     (true, None) => *st = Some(y),
                     (false, Some(s)) => {
-                        mark(&mut |j, r| along_y[j * w + x] = Some(r), s, y - s);
+                        mark(&mut |j, r| along_y[j * w + x] = r, s, y - s);
                         *st = None;
                     }
                     _ => {}
@@ -510,10 +518,13 @@ impl ThinRuns {
         } else {
             &self.along_y
         };
-        runs.get(y * self.width + x)
-            .copied()
-            .flatten()
-            .map(|(a, b)| (i32::from(a), i32::from(b)))
+        match runs.get(y * self.width + x).copied() {
+            None | Some(0) => None,
+            Some(c) => {
+                let c = i32::from(c) - 1;
+                Some((-(c / 3), c % 3))
+            }
+        }
     }
 }
 

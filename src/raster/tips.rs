@@ -21,6 +21,7 @@
 //! holes sample's outline 1.35 → 0.51 px from its drawing (the star's and
 //! the triangle's points), IoU within ±0.001.
 
+use crate::trace::contour::wrap_once;
 use kurbo::{Point, Vec2};
 
 /// Longest stretch (px of arc) that may be replaced by a point: the cut
@@ -68,7 +69,7 @@ impl<'a> Arc<'a> {
     /// The point at arc length `s` (wrapping round the loop).
     fn at(&self, s: f64) -> Point {
         let n = self.pts.len();
-        let s = s.rem_euclid(self.total);
+        let s = wrap_once(s, self.total);
         let i = self
             .cum
             .partition_point(|&c| c <= s)
@@ -145,14 +146,23 @@ fn window_turning(arc: &Arc) -> Vec<f64> {
         .collect();
     // turn[k]: at vertex k, from segment k − 1 to segment k.
     let turn: Vec<f64> = (0..n)
-        .map(|k| (dir[k] - dir[(k + n - 1) % n] + 180.0).rem_euclid(360.0) - 180.0)
+        .map(|k| wrap_once(dir[k] - dir[(k + n - 1) % n] + 180.0, 360.0) - 180.0)
         .collect();
     let mut prefix = vec![0.0; 3 * n + 1];
-    for k in 0..3 * n {
-        prefix[k + 1] = prefix[k] + turn[k % n];
+    for (k, t) in turn.iter().cycle().take(3 * n).enumerate() {
+        prefix[k + 1] = prefix[k] + t;
     }
-    // Arc length at vertex k of the tripled loop.
-    let s = |k: usize| arc.cum[k % n] + (k / n) as f64 * arc.total;
+    // Arc length at vertex k of the tripled loop (k < 3n; the rounds
+    // picked by comparison, not division).
+    let s = |k: usize| {
+        if k < n {
+            arc.cum[k]
+        } else if k < 2 * n {
+            arc.cum[k - n] + arc.total
+        } else {
+            arc.cum[k - 2 * n] + 2.0 * arc.total
+        }
+    };
     let (mut lo, mut hi) = (0usize, 0usize);
     (0..n)
         .map(|i| {
@@ -197,6 +207,9 @@ pub fn sharpen(pts: Vec<Point>) -> Vec<Point> {
         return pts;
     }
     let turning = window_turning(&arc);
+    // Each vertex's forward side, measured once: the stretches from the
+    // vertices up to MAX_CUT before it all ask for it.
+    let mut forward: Vec<Option<Option<(Point, Point)>>> = vec![None; n];
     let mut found = Vec::new();
     for (i, t) in turning.iter().enumerate() {
         // Only where the outline turns enough round the stretch and its
@@ -218,7 +231,8 @@ pub fn sharpen(pts: Vec<Point>) -> Vec<Point> {
             if s1 - arc.cum[i] > MAX_CUT || j == i {
                 break;
             }
-            let Some((b1, b0)) = arc.side(j, true) else {
+            let side = *forward[j].get_or_insert_with(|| arc.side(j, true));
+            let Some((b1, b0)) = side else {
                 continue;
             };
             let w = b1 - b0;
@@ -256,14 +270,14 @@ pub fn sharpen(pts: Vec<Point>) -> Vec<Point> {
     });
     // Whether arc length `s` lies strictly inside `a`'s stretch (mod the loop).
     let within = |a: &Apex, s: f64| {
-        let d = (s - a.s0).rem_euclid(arc.total);
+        let d = wrap_once(s - a.s0, arc.total);
         d > 0.0 && d < a.s1 - a.s0
     };
     let mut kept: Vec<Apex> = Vec::new();
     for a in found {
         // Neither stretch may reach into the other's stretch or sides.
         let clear = kept.iter().all(|k| {
-            let d = (a.s0 - k.s0).rem_euclid(arc.total);
+            let d = wrap_once(a.s0 - k.s0, arc.total);
             let (len_a, len_k) = (a.s1 - a.s0, k.s1 - k.s0);
             d >= len_k + SIDE && arc.total - d >= len_a + SIDE
         });

@@ -79,15 +79,32 @@ impl Contour {
 /// Cumulative arc lengths (px) round a closed polygon: `cum[i]` to vertex
 /// `i`, `cum[n]` the whole loop (the closing edge included).
 pub fn closed_arc_lengths(points: &[Point]) -> Vec<f64> {
-    let n = points.len();
-    let mut cum = Vec::with_capacity(n + 1);
+    let mut cum = Vec::with_capacity(points.len() + 1);
     let mut s = 0.0;
     cum.push(0.0);
-    for i in 0..n {
-        s += (points[(i + 1) % n] - points[i]).hypot();
+    for (p, q) in points.iter().zip(points.iter().cycle().skip(1)) {
+        s += (*q - *p).hypot();
         cum.push(s);
     }
     cum
+}
+
+/// `x` brought into `0..period` by adding or subtracting one period: the
+/// same number as `x.rem_euclid(period)` for `x` in `−period..2·period`
+/// (both add exactly `period` below zero, and from `period` up to twice
+/// it the difference is exact), without the division.
+pub fn wrap_once(x: f64, period: f64) -> f64 {
+    if x < 0.0 {
+        if x == -period {
+            // What `rem_euclid` gives: the remainder's sign, zero.
+            return -0.0;
+        }
+        x + period
+    } else if x >= period {
+        x - period
+    } else {
+        x
+    }
 }
 
 /// Shoelace signed area of a closed polygon.
@@ -326,6 +343,43 @@ pub fn contains(poly: &[Point], p: Point) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `wrap_once` is `rem_euclid` to the bit over one period either side,
+    /// the ends and signed zeros included.
+    #[test]
+    fn wrap_once_is_rem_euclid_within_a_period() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut rnd = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..20000 {
+            let period =
+                [360.0, std::f64::consts::TAU, 1e-3 + 5e3 * rnd()][(rnd() * 3.0) as usize % 3];
+            let x = (3.0 * rnd() - 1.0) * period;
+            assert_eq!(
+                wrap_once(x, period).to_bits(),
+                x.rem_euclid(period).to_bits(),
+                "{x} mod {period}"
+            );
+        }
+        for (x, p) in [
+            (0.0, 5.0),
+            (-0.0, 5.0),
+            (5.0, 5.0),
+            (-5.0, 5.0),
+            (-1e-300, 5.0),
+            (9.999999999, 5.0),
+        ] {
+            assert_eq!(
+                wrap_once(x, p).to_bits(),
+                f64::rem_euclid(x, p).to_bits(),
+                "{x} mod {p}"
+            );
+        }
+    }
 
     fn field(w: usize, h: usize, f: impl Fn(f64, f64) -> f64) -> Grid<f32> {
         Grid::from_fn(w, h, |x, y| f(x as f64 + 0.5, y as f64 + 0.5) as f32)

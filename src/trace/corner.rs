@@ -29,22 +29,30 @@ pub fn corners(pts: &[Point]) -> Vec<usize> {
     if total < 4.0 * CORNER_WINDOW {
         return Vec::new();
     }
-    // Point at arc length s along the closed polygon (wrapping).
-    let at = |s: f64| -> Point {
-        let s = s.rem_euclid(total);
-        let i = match cum.binary_search_by(|c: &f64| c.total_cmp(&s)) {
-            Ok(i) => i.min(n - 1),
-            Err(i) => i.saturating_sub(1).min(n - 1),
-        };
+    // Point at arc length s along the closed polygon (wrapping), on the
+    // last segment starting at or before it. The arc lengths asked for
+    // climb with the vertex, so each of the two reads keeps a cursor that
+    // steps forwards (searching afresh only where the loop wraps).
+    let at = |s: f64, cursor: &mut usize| -> Point {
+        let s = super::contour::wrap_once(s, total);
+        let mut i = *cursor;
+        if cum[i] > s {
+            i = cum[..n].partition_point(|&c| c <= s).saturating_sub(1);
+        }
+        while i + 1 < n && cum[i + 1] <= s {
+            i += 1;
+        }
+        *cursor = i;
         let seg = cum[i + 1] - cum[i];
         let t = if seg > 0.0 { (s - cum[i]) / seg } else { 0.0 };
         pts[i].lerp(pts[(i + 1) % n], t)
     };
+    let (mut behind, mut ahead) = (0usize, 0usize);
     let turn: Vec<f64> = (0..n)
         .map(|i| {
             let p = pts[i];
-            let a = p - at(cum[i] - CORNER_WINDOW);
-            let b = at(cum[i] + CORNER_WINDOW) - p;
+            let a = p - at(cum[i] - CORNER_WINDOW, &mut behind);
+            let b = at(cum[i] + CORNER_WINDOW, &mut ahead) - p;
             a.cross(b).atan2(a.dot(b)).abs()
         })
         .collect();
@@ -56,14 +64,14 @@ pub fn corners(pts: &[Point]) -> Vec<usize> {
         // Local maximum within the window (ties broken by index).
         let mut is_max = true;
         let mut j = (i + 1) % n;
-        while j != i && (cum[j] - cum[i]).rem_euclid(total) < CORNER_SEPARATION {
+        while j != i && super::contour::wrap_once(cum[j] - cum[i], total) < CORNER_SEPARATION {
             if turn[j] > turn[i] {
                 is_max = false;
             }
             j = (j + 1) % n;
         }
         let mut j = (i + n - 1) % n;
-        while j != i && (cum[i] - cum[j]).rem_euclid(total) < CORNER_SEPARATION {
+        while j != i && super::contour::wrap_once(cum[i] - cum[j], total) < CORNER_SEPARATION {
             if turn[j] >= turn[i] {
                 is_max = false;
             }

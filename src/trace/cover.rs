@@ -108,8 +108,9 @@ fn turning(piece: &Piece) -> Vec<f64> {
         if piece.arc_at(i) - piece.arc_at(anchor) >= TURN_STEP || i == n - 1 {
             let d = (piece.point(i) - piece.point(anchor)).atan2();
             if let Some(p) = prev_dir {
-                let t = (d - p + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
-                    - std::f64::consts::PI;
+                let t =
+                    super::contour::wrap_once(d - p + std::f64::consts::PI, std::f64::consts::TAU)
+                        - std::f64::consts::PI;
                 total += t.abs();
             }
             prev_dir = Some(d);
