@@ -22,6 +22,7 @@ fn bench_trace(c: &mut Criterion) {
         "glyph-a.png",
         "ornament-scroll.png",
         "ornament-2mp.png",
+        "ornament-2mp-aa.png",
         "ornament-scroll.svg",
     ] {
         let path = sample(name);

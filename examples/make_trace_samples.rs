@@ -17,7 +17,9 @@
 //! * `holes`: nested holes and islands (even-odd fill), tiny holes, frames.
 //! * `two-colour`: three stacked fill colours for the tracer's `--layers` mode.
 //! * `ornament-2mp`: a 1414x1414 framed ornament (scroll border, rosette
-//!   centre), thresholded to black/white, for benchmarking against potrace.
+//!   centre), thresholded to black/white, for benchmarking against potrace;
+//!   `ornament-2mp-aa.png` is the same drawing anti-aliased, as a scan or a
+//!   render reaches the tracer (no SVG of its own: `ornament-2mp.svg`).
 //!
 //! Each drawing is written as `NAME.svg` (ground truth) and `NAME.png`
 //! (rendered with resvg on white, anti-aliased, 8-bit grayscale; RGB for
@@ -1215,10 +1217,14 @@ enum Out {
     Rgb,
     /// Thresholded black/white PNG only.
     BinaryOnly,
+    /// Anti-aliased grayscale PNG only, no SVG (another name's drawing).
+    GrayOnly,
 }
 
 fn emit(dir: &Path, name: &str, art: &Art, out: Out) {
-    std::fs::write(dir.join(format!("{name}.svg")), art.svg()).expect("write SVG");
+    if out != Out::GrayOnly {
+        std::fs::write(dir.join(format!("{name}.svg")), art.svg()).expect("write SVG");
+    }
     let pm = render(art);
     let px = pm.data();
     let gray: Vec<u8> = px
@@ -1234,7 +1240,7 @@ fn emit(dir: &Path, name: &str, art: &Art, out: Out) {
         .collect();
     let (w, h) = (art.w, art.h);
     match out {
-        Out::Gray | Out::GrayAndBinary => {
+        Out::Gray | Out::GrayAndBinary | Out::GrayOnly => {
             save_png(
                 &dir.join(format!("{name}.png")),
                 w,
@@ -1297,4 +1303,6 @@ fn main() {
     emit(&dir, "holes", &holes(), Out::Gray);
     emit(&dir, "two-colour", &two_colour(), Out::Rgb);
     emit(&dir, "ornament-2mp", &ornament_2mp(), Out::BinaryOnly);
+    // The same drawing anti-aliased; its truth is `ornament-2mp.svg`.
+    emit(&dir, "ornament-2mp-aa", &ornament_2mp(), Out::GrayOnly);
 }

@@ -44,11 +44,15 @@ pub fn sample(name: &str) -> PathBuf {
     root().join("samples/trace").join(name)
 }
 
-/// The ground-truth SVG of a sample PNG: `NAME.svg` for `NAME.png` and
-/// `NAME-binary.png`.
+/// The ground-truth SVG of a sample PNG: `NAME.svg` for `NAME.png`,
+/// `NAME-binary.png` and `NAME-aa.png`.
 pub fn truth_svg_for(png: &Path) -> PathBuf {
     let stem = png.file_stem().unwrap().to_string_lossy().to_string();
-    let stem = stem.strip_suffix("-binary").unwrap_or(&stem).to_string();
+    let stem = stem
+        .strip_suffix("-binary")
+        .or_else(|| stem.strip_suffix("-aa"))
+        .unwrap_or(&stem)
+        .to_string();
     png.with_file_name(format!("{stem}.svg"))
 }
 
