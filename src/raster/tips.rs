@@ -286,15 +286,34 @@ pub fn sharpen(pts: Vec<Point>) -> Vec<Point> {
         }
     }
     // The vertices strictly inside a kept stretch give way to its point,
-    // which follows the stretch's first vertex.
+    // which follows the stretch's first vertex. A stretch's vertices are
+    // the ones after its first, up to where its arc ends: marked by
+    // walking each stretch (the stretches are disjoint), not by testing
+    // every vertex against every stretch.
+    let mut inside = vec![false; n];
+    let mut point_after: Vec<Option<Point>> = vec![None; n];
+    for a in &kept {
+        if let Some(slot) = point_after.get_mut(a.first) {
+            *slot = Some(a.point);
+        }
+        let mut j = a.first;
+        for _ in 1..n {
+            j = if j + 1 == n { 0 } else { j + 1 };
+            let s = arc.cum[j];
+            if wrap_once(s - a.s0, arc.total) >= a.s1 - a.s0 {
+                break;
+            }
+            inside[j] |= within(a, s);
+        }
+    }
     let mut out = Vec::with_capacity(n);
-    for (i, (&p, &s)) in pts.iter().zip(&arc.cum).enumerate() {
-        if kept.iter().any(|a| within(a, s)) {
+    for (i, &p) in pts.iter().enumerate() {
+        if inside[i] {
             continue;
         }
         out.push(p);
-        if let Some(a) = kept.iter().find(|a| a.first == i) {
-            out.push(a.point);
+        if let Some(q) = point_after[i] {
+            out.push(q);
         }
     }
     out
