@@ -430,6 +430,27 @@ fn directory_as_input_fails_cleanly() {
 // trace: degenerate but valid inputs
 
 #[test]
+fn endless_device_as_input_fails_at_the_size_limit() {
+    // /dev/zero has no length to check beforehand: it was read until memory
+    // ran out (gigabytes). Reading stops at the file size limit instead.
+    let dev = Path::new("/dev/zero");
+    if !dev.exists() {
+        return;
+    }
+    let t = tempdir();
+    let out = t.path().join("out.svg");
+    for cmd in ["trace", "fill"] {
+        let (o, _) = flourish_timed(
+            t.path(),
+            &[cmd, s(dev), "-o", s(&out)],
+            Duration::from_secs(30),
+        );
+        assert_failure(&o, dev, &["limit"]);
+        assert!(!out.exists());
+    }
+}
+
+#[test]
 fn all_white_image_gives_valid_empty_svg() {
     let t = tempdir();
     let p = t.path().join("white.png");
