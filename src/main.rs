@@ -624,6 +624,10 @@ fn run_diff(args: DiffArgs, quiet: bool) -> Result<(), Failure> {
             args.tolerance
         )));
     }
+    if let Some(out) = &args.out {
+        check_not_input(&args.expected, out)?;
+        check_not_input(&args.actual, out)?;
+    }
     let report = diff::diff_files(&args.expected, &args.actual)?;
     if let Some(out) = &args.out {
         diff::write_panels(&report, out)?;
@@ -646,6 +650,14 @@ fn run_style_check(args: StyleCheckArgs, quiet: bool) -> Result<(), Failure> {
     use flourish::style::{self, brush, check};
     let styles_dir = args.styles.unwrap_or_else(style::default_styles_dir);
     let dir = style::resolve(&args.style, &styles_dir)?;
+    if let Some(sheet) = &args.sheet {
+        // The sheet must not replace the style's own files.
+        let toml = style::load(&dir)?;
+        check_not_input(&dir.join(style::STYLE_FILE), sheet)?;
+        for ex in &toml.exemplar {
+            check_not_input(&dir.join(&ex.file), sheet)?;
+        }
+    }
     let opts = brush::AnalysisOptions {
         cache_dir: args.cache,
         use_cache: !args.no_cache,

@@ -1366,6 +1366,26 @@ fn diff_out_in_missing_folder_fails_cleanly() {
     assert!(!d.exists());
 }
 
+#[test]
+fn diff_out_equal_to_an_input_is_refused() {
+    // `diff a.svg b.svg --out b.svg` wrote the panels PNG over b.svg.
+    let t = tempdir();
+    let a = write(t.path(), "a.svg", SQUARE_SVG);
+    let b = write(t.path(), "b.svg", SQUARE_SVG_MOVED);
+    for (out, text) in [(&a, SQUARE_SVG), (&b, SQUARE_SVG_MOVED)] {
+        let o = flourish(&["diff", s(&a), s(&b), "--out", s(out)]);
+        assert_failure(&o, out, &["overwrite"]);
+        assert_eq!(std::fs::read_to_string(out).unwrap(), text, "input changed");
+        assert!(o.stdout.is_empty(), "stdout: {}", stdout(&o));
+    }
+    // Through another spelling of the same path.
+    let other = t.path().join(".").join("b.svg");
+    let o = flourish(&["diff", s(&a), s(&b), "--out", s(&other)]);
+    assert_failure(&o, &b, &["overwrite"]);
+    assert_eq!(std::fs::read_to_string(&b).unwrap(), SQUARE_SVG_MOVED);
+    assert_no_temp_files(t.path());
+}
+
 // ---------------------------------------------------------------------------
 // Previews and file modes
 
