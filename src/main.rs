@@ -27,7 +27,7 @@ struct Cli {
     /// Print notes about what was read and skipped.
     #[arg(short, long, global = true)]
     verbose: bool,
-    /// Worker threads (default: one per core); output does not depend on it.
+    /// Worker threads, 1..=1024 (default: one per core); output does not depend on it.
     #[arg(long, global = true, value_name = "N")]
     threads: Option<usize>,
 }
@@ -147,7 +147,7 @@ struct BrushArgs {
     /// Refinement sketch: black strokes add ornament, white ones erase it (DecoBrush §5.5).
     #[arg(long, value_name = "REFINE.svg")]
     refine: Option<PathBuf>,
-    /// Correction iterations per synthesis level (0: graph cut upsampled only).
+    /// Correction iterations per synthesis level, 0..=100 (0: graph cut upsampled only).
     #[arg(long, default_value_t = 1, value_name = "N")]
     iterations: usize,
 }
@@ -244,10 +244,23 @@ fn main() -> ExitCode {
     }
 }
 
+/// Most worker threads `--threads` may ask for (each is an OS thread
+/// started up front; a million of them never finish starting).
+const MAX_THREADS: usize = 1024;
+
+/// Most correction iterations per level `brush --iterations` may ask for
+/// (each costs about one synthesis pass).
+const MAX_ITERATIONS: usize = 100;
+
 fn run(cli: Cli) -> Result<(), Failure> {
     if let Some(n) = cli.threads {
         if n == 0 {
             return Err(Failure::Usage("--threads must be at least 1".into()));
+        }
+        if n > MAX_THREADS {
+            return Err(Failure::Usage(format!(
+                "--threads {n} is more than the limit of {MAX_THREADS}"
+            )));
         }
         rayon::ThreadPoolBuilder::new()
             .num_threads(n)
@@ -392,6 +405,12 @@ fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
     use flourish::style::brush::{AnalysisOptions, BrushStyle};
     if args.variations == 0 || args.variations > 100 {
         return Err(Failure::Usage("--variations must be in 1..=100".into()));
+    }
+    if args.iterations > MAX_ITERATIONS {
+        return Err(Failure::Usage(format!(
+            "--iterations {} is not in 0..={MAX_ITERATIONS}",
+            args.iterations
+        )));
     }
     if args.variations > 1
         && args.out.out_dir.is_none()

@@ -889,6 +889,8 @@ fn bad_min_area_resolution_threads_are_usage_errors() {
         (vec!["--resolution", "0"], "resolution"),
         (vec!["--resolution=-5"], "resolution"),
         (vec!["--threads", "0"], "threads"),
+        // Each would be a thread: a million of them never got started.
+        (vec!["--threads", "1000000"], "threads"),
     ] {
         let mut full = vec!["trace", s(&a), "-o", s(&out)];
         full.extend(args.iter().copied());
@@ -1586,4 +1588,34 @@ fn brush_variations_with_out_dir_name_each_variation() {
     }
     let o = flourish(&["brush", "--style", "doodle", s(&a), "--variations", "2"]);
     assert_usage(&o, "--variations");
+}
+
+#[test]
+fn brush_iterations_out_of_range_is_a_usage_error() {
+    // `--iterations 1000000000` ran a billion correction passes (a hang).
+    let t = tempdir();
+    let a = write(
+        t.path(),
+        "wave.svg",
+        r##"<svg xmlns="http://www.w3.org/2000/svg" width="200" height="100">
+<path d="M20 50 C 60 10, 140 90, 180 50" fill="none" stroke="#000" stroke-width="20"/>
+</svg>"##,
+    );
+    let out = t.path().join("out.svg");
+    let (o, _) = flourish_timed(
+        t.path(),
+        &[
+            "brush",
+            "--style",
+            "doodle",
+            s(&a),
+            "-o",
+            s(&out),
+            "--iterations",
+            "1000000000",
+        ],
+        Duration::from_secs(60),
+    );
+    assert_usage(&o, "--iterations");
+    assert!(!out.exists());
 }
