@@ -432,6 +432,8 @@ fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
             seed: args.out.seed.wrapping_add(k as u64),
             art_brush: args.art_brush,
             refine: args.refine.clone(),
+            // Only --verbose reads the fields (each query's energy).
+            discard_fields: !verbose,
             synth: flourish::brush::synth::SynthOptions {
                 iterations: args.iterations,
                 ..Default::default()

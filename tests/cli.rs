@@ -1619,3 +1619,52 @@ fn brush_iterations_out_of_range_is_a_usage_error() {
     assert_usage(&o, "--iterations");
     assert!(!out.exists());
 }
+
+#[test]
+fn brush_memory_does_not_grow_with_the_number_of_strokes() {
+    // Every query's synthesized fields (~2 MB for a short stroke, ~18 MB
+    // for a long one) were kept until the whole sketch was done: 200 tiny
+    // strokes took 540 MB, 5000 ran out of memory and aborted. Now each
+    // query's fields go once it is traced. Run under a 400 MB address
+    // space limit (the run itself needs about 130 MB).
+    let t = tempdir();
+    let mut body = String::new();
+    for i in 0..200 {
+        let (x, y) = (10.0 + (i % 20) as f64 * 9.0, 10.0 + (i / 20) as f64 * 9.0);
+        body.push_str(&format!(
+            r##"<path d="M{x} {y} l0.3 0.2" fill="none" stroke="#000" stroke-width="0.5"/>"##
+        ));
+    }
+    let a = write(
+        t.path(),
+        "many.svg",
+        &format!(
+            r##"<svg xmlns="http://www.w3.org/2000/svg" width="200" height="200">{body}</svg>"##
+        ),
+    );
+    let out = t.path().join("out.svg");
+    let cache = t.path().join("cache");
+    let o = Command::new("sh")
+        .arg("-c")
+        .arg(r#"ulimit -v 400000 && exec "$0" "$@""#)
+        .arg(BIN)
+        .args([
+            "--threads",
+            "2",
+            "brush",
+            "--style",
+            "doodle",
+            "--cache",
+            s(&cache),
+            s(&a),
+            "-o",
+            s(&out),
+        ])
+        .stdin(Stdio::null())
+        .output()
+        .expect("run flourish");
+    assert_eq!(code(&o), Some(0), "stderr: {}", stderr(&o));
+    let svg = std::fs::read(&out).unwrap();
+    let tree = parse_output(&svg).expect("output parses");
+    assert_eq!(tree.root().children().len(), 200, "one group per stroke");
+}

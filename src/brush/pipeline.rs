@@ -50,6 +50,13 @@ pub struct BrushOptions {
     /// A refinement sketch (§5.5, `--refine`): black strokes add ink,
     /// white ones erase it; same viewBox as the sketch.
     pub refine: Option<std::path::PathBuf>,
+    /// Drop each query's synthesized fields once it is traced: the
+    /// [`QueryResult`]s of [`crate::brush::output::BrushOutput`] keep their
+    /// spine, canvas and segments but an empty `field` and no `levels`, so
+    /// a sketch of thousands of strokes needs the memory of the few being
+    /// synthesized at a time, not of all of them (about 18 MB each for a
+    /// 556×556 px canvas). The document is the same either way.
+    pub discard_fields: bool,
 }
 
 /// A query's canvas: finest-level pixel `(x, y)` has its centre at sketch
