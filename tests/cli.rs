@@ -1668,3 +1668,45 @@ fn brush_memory_does_not_grow_with_the_number_of_strokes() {
     let tree = parse_output(&svg).expect("output parses");
     assert_eq!(tree.root().children().len(), 200, "one group per stroke");
 }
+
+#[test]
+fn data_style_reads_only_the_styles_folder() {
+    // A shape's data-style="/abs/folder" (or "../x") was read as a folder
+    // path, so a sketch could make flourish read any folder's style.toml
+    // and exemplars; a missing one was reported without the sketch's name.
+    let t = tempdir();
+    let styles = t.path().join("styles");
+    std::fs::create_dir(&styles).unwrap();
+    let shipped = flourish::style::default_styles_dir();
+    for (cmd, style) in [("pattern", "stipple"), ("fill", "knot")] {
+        let outside = shipped.join(style);
+        for (name, cause) in [
+            (s(&outside).to_string(), "not a style name"),
+            (format!("../{style}"), "not a style name"),
+            (String::new(), "not a style name"),
+            ("missing".to_string(), "not found"),
+        ] {
+            let a = write(
+                t.path(),
+                "shape.svg",
+                &format!(
+                    r##"<svg xmlns="http://www.w3.org/2000/svg" width="200" height="200">
+<circle cx="100" cy="100" r="80" fill="#ccc" data-style="{name}"/></svg>"##
+                ),
+            );
+            let out = t.path().join("out.svg");
+            let o = flourish(&[
+                cmd,
+                "--styles",
+                s(&styles),
+                "--style",
+                s(&outside),
+                s(&a),
+                "-o",
+                s(&out),
+            ]);
+            assert_failure(&o, &a, &["data-style", cause]);
+            assert!(!out.exists(), "{cmd} {name:?}: output written");
+        }
+    }
+}
