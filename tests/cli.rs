@@ -1710,3 +1710,35 @@ fn data_style_reads_only_the_styles_folder() {
         }
     }
 }
+
+#[test]
+fn brush_thin_diagonal_stroke_is_refused_at_the_canvas_limit() {
+    // One stroke 1.45 units wide across a 200-unit sketch: a 7900×7900 px
+    // canvas (under the general 64 Mpx limit) on which the synthesis took
+    // over 7 GB and aborted ("memory allocation failed", exit 134).
+    let t = tempdir();
+    let a = write(
+        t.path(),
+        "diagonal.svg",
+        r##"<svg xmlns="http://www.w3.org/2000/svg" width="200" height="200">
+<path d="M2 2 L198 198" fill="none" stroke="#000" stroke-width="1.45"/></svg>"##,
+    );
+    let out = t.path().join("out.svg");
+    let cache = std::env::temp_dir().join("flourish-test-cache");
+    let (o, _) = flourish_timed(
+        t.path(),
+        &[
+            "brush",
+            "--style",
+            "vine",
+            "--cache",
+            s(&cache),
+            s(&a),
+            "-o",
+            s(&out),
+        ],
+        Duration::from_secs(30),
+    );
+    assert_failure(&o, &a, &["size limit", "wider"]);
+    assert!(!out.exists());
+}
