@@ -1776,3 +1776,19 @@ fn brush_thin_diagonal_stroke_is_refused_at_the_canvas_limit() {
     assert_failure(&o, &a, &["size limit", "wider"]);
     assert!(!out.exists());
 }
+
+#[test]
+fn file_name_with_a_newline_is_named_on_one_line() {
+    // "new\nline.svg" was printed as is: a two-line error.
+    let t = tempdir();
+    let p = write(t.path(), "new\nline.svg", "not an svg");
+    let out = t.path().join("out.svg");
+    for cmd in ["trace", "pattern"] {
+        let o = flourish(&[cmd, s(&p), "-o", s(&out)]);
+        assert_eq!(code(&o), Some(1), "stderr: {}", stderr(&o));
+        let err = stderr(&o);
+        assert_eq!(err.lines().count(), 1, "{err:?}");
+        assert!(err.contains("new\\nline.svg"), "{err:?}");
+        assert!(!out.exists());
+    }
+}
