@@ -543,6 +543,12 @@ fn run_jobs(
             check_not_input(inp, out)?;
             if let Some(p) = preview {
                 check_not_input(inp, p)?;
+                if out.as_os_str() == "-" && p.as_os_str() == "-" {
+                    // The SVG and the PNG would run together on stdout.
+                    return Err(Failure::Usage(
+                        "--preview - and -o - both name standard output".into(),
+                    ));
+                }
                 if out.as_os_str() != "-" && io::same_file(out, p) {
                     return Err(Failure::Usage("--preview and -o name the same file".into()));
                 }

@@ -1477,6 +1477,17 @@ fn preview_equal_to_output_is_refused() {
 }
 
 #[test]
+fn preview_and_output_both_on_stdout_is_refused() {
+    // `-o - --preview -` wrote the SVG and then the PNG to stdout, run
+    // together into one corrupt stream.
+    let t = tempdir();
+    let a = t.path().join("a.png");
+    write_disc_png(&a, 20);
+    let o = flourish(&["trace", s(&a), "-o", "-", "--preview", "-"]);
+    assert_usage(&o, "standard output");
+}
+
+#[test]
 fn failed_preview_leaves_no_svg_behind() {
     let t = tempdir();
     let a = t.path().join("a.png");
