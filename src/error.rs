@@ -13,7 +13,7 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     /// Reading or writing a file failed.
-    #[error("{}: {source}", path.display())]
+    #[error("{}: {source}", shown(path))]
     Io {
         /// The file concerned.
         path: PathBuf,
@@ -22,7 +22,7 @@ pub enum Error {
         source: std::io::Error,
     },
     /// A raster file could not be decoded.
-    #[error("{}: not a readable image: {reason}", path.display())]
+    #[error("{}: not a readable image: {reason}", shown(path))]
     Image {
         /// The file concerned.
         path: PathBuf,
@@ -30,7 +30,7 @@ pub enum Error {
         reason: String,
     },
     /// An SVG file could not be parsed.
-    #[error("{}: SVG does not parse: {reason}", path.display())]
+    #[error("{}: SVG does not parse: {reason}", shown(path))]
     Svg {
         /// The file concerned.
         path: PathBuf,
@@ -38,7 +38,7 @@ pub enum Error {
         reason: String,
     },
     /// An input or requested canvas exceeds the resource limits.
-    #[error("{}: {} exceeds the size limit ({limit})", path.display(), canvas_size(*width, *height))]
+    #[error("{}: {} exceeds the size limit ({limit})", shown(path), canvas_size(*width, *height))]
     TooLarge {
         /// The file concerned.
         path: PathBuf,
@@ -50,7 +50,7 @@ pub enum Error {
         limit: String,
     },
     /// The input is well-formed but cannot be used (degenerate, empty, NaN…).
-    #[error("{}: {reason}", path.display())]
+    #[error("{}: {reason}", shown(path))]
     Invalid {
         /// The file concerned.
         path: PathBuf,
@@ -102,6 +102,24 @@ impl Error {
     }
 }
 
+/// A path for a one-line message: control characters (a newline in a file
+/// name) written as escapes, so the message stays on one line.
+fn shown(path: &std::path::Path) -> String {
+    let text = path.display().to_string();
+    if !text.chars().any(char::is_control) {
+        return text;
+    }
+    text.chars()
+        .map(|c| {
+            if c.is_control() {
+                c.escape_default().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
+}
+
 /// A canvas size for messages: `W×H px` up to a billion px per side, else
 /// its order of magnitude (a saturated 2⁶⁴ − 1 from absurd coordinates
 /// reads "over 10¹⁹ px per side").
@@ -124,6 +142,18 @@ fn canvas_size(width: u64, height: u64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A file name with a newline or other control character is named
+    /// on one line, its control characters escaped.
+    #[test]
+    fn file_names_are_shown_on_one_line() {
+        let e = Error::invalid("new\nline\t.svg", "bad");
+        assert_eq!(e.to_string(), "new\\nline\\t.svg: bad");
+        assert_eq!(
+            Error::invalid("plain ✓.svg", "bad").to_string(),
+            "plain ✓.svg: bad"
+        );
+    }
 
     #[test]
     fn size_errors_read_well_for_sane_and_absurd_sizes() {

@@ -37,7 +37,9 @@ pub fn check_canvas(path: &Path, width: u64, height: u64) -> Result<()> {
     Ok(())
 }
 
-/// Reads a whole file, refusing files over [`MAX_FILE_BYTES`].
+/// Reads a whole file, refusing files over [`MAX_FILE_BYTES`]: by their
+/// size when they have one, and for devices and pipes (whose size reads 0,
+/// such as `/dev/zero`) by stopping there.
 pub fn read_file(path: &Path) -> Result<Vec<u8>> {
     let meta = std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
     if meta.is_dir() {
@@ -52,7 +54,25 @@ pub fn read_file(path: &Path) -> Result<Vec<u8>> {
             ),
         ));
     }
-    std::fs::read(path).map_err(|e| Error::io(path, e))
+    read_capped(path, MAX_FILE_BYTES)
+}
+
+/// Reads `path` to its end or to `cap` + 1 bytes, whichever comes first;
+/// more than `cap` bytes is an error.
+fn read_capped(path: &Path, cap: u64) -> Result<Vec<u8>> {
+    use std::io::Read as _;
+    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let mut out = Vec::new();
+    file.take(cap + 1)
+        .read_to_end(&mut out)
+        .map_err(|e| Error::io(path, e))?;
+    if out.len() as u64 > cap {
+        return Err(Error::invalid(
+            path,
+            format!("file exceeds the limit of {cap} bytes"),
+        ));
+    }
+    Ok(out)
 }
 
 /// usvg options that never touch the file system or the network: external
@@ -209,6 +229,21 @@ mod tests {
         let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
         enc.write_all(data).expect("compresses");
         enc.finish().expect("compresses")
+    }
+
+    /// A file is read up to the cap and refused past it, named in the
+    /// error (a device such as /dev/zero has no size to check first).
+    #[test]
+    fn reads_stop_at_the_cap() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let path = dir.path().join("big.svg");
+        std::fs::write(&path, vec![b' '; 100]).expect("writes");
+        assert_eq!(read_capped(&path, 100).expect("at the cap").len(), 100);
+        let e = read_capped(&path, 99).expect_err("over the cap");
+        assert!(
+            e.to_string().contains("big.svg") && e.to_string().contains("limit"),
+            "{e}"
+        );
     }
 
     /// SVGZ inflates to the SVG it holds, plain SVG passes as it is, and

@@ -27,7 +27,7 @@ struct Cli {
     /// Print notes about what was read and skipped.
     #[arg(short, long, global = true)]
     verbose: bool,
-    /// Worker threads (default: one per core); output does not depend on it.
+    /// Worker threads, 1..=1024 (default: one per core); output does not depend on it.
     #[arg(long, global = true, value_name = "N")]
     threads: Option<usize>,
 }
@@ -147,7 +147,7 @@ struct BrushArgs {
     /// Refinement sketch: black strokes add ornament, white ones erase it (DecoBrush §5.5).
     #[arg(long, value_name = "REFINE.svg")]
     refine: Option<PathBuf>,
-    /// Correction iterations per synthesis level (0: graph cut upsampled only).
+    /// Correction iterations per synthesis level, 0..=100 (0: graph cut upsampled only).
     #[arg(long, default_value_t = 1, value_name = "N")]
     iterations: usize,
 }
@@ -244,10 +244,23 @@ fn main() -> ExitCode {
     }
 }
 
+/// Most worker threads `--threads` may ask for (each is an OS thread
+/// started up front; a million of them never finish starting).
+const MAX_THREADS: usize = 1024;
+
+/// Most correction iterations per level `brush --iterations` may ask for
+/// (each costs about one synthesis pass).
+const MAX_ITERATIONS: usize = 100;
+
 fn run(cli: Cli) -> Result<(), Failure> {
     if let Some(n) = cli.threads {
         if n == 0 {
             return Err(Failure::Usage("--threads must be at least 1".into()));
+        }
+        if n > MAX_THREADS {
+            return Err(Failure::Usage(format!(
+                "--threads {n} is more than the limit of {MAX_THREADS}"
+            )));
         }
         rayon::ThreadPoolBuilder::new()
             .num_threads(n)
@@ -393,6 +406,12 @@ fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
     if args.variations == 0 || args.variations > 100 {
         return Err(Failure::Usage("--variations must be in 1..=100".into()));
     }
+    if args.iterations > MAX_ITERATIONS {
+        return Err(Failure::Usage(format!(
+            "--iterations {} is not in 0..={MAX_ITERATIONS}",
+            args.iterations
+        )));
+    }
     if args.variations > 1
         && args.out.out_dir.is_none()
         && (args.out.output.is_none() || args.out.output.as_deref() == Some(Path::new("-")))
@@ -413,6 +432,8 @@ fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
             seed: args.out.seed.wrapping_add(k as u64),
             art_brush: args.art_brush,
             refine: args.refine.clone(),
+            // Only --verbose reads the fields (each query's energy).
+            discard_fields: !verbose,
             synth: flourish::brush::synth::SynthOptions {
                 iterations: args.iterations,
                 ..Default::default()
@@ -522,6 +543,12 @@ fn run_jobs(
             check_not_input(inp, out)?;
             if let Some(p) = preview {
                 check_not_input(inp, p)?;
+                if out.as_os_str() == "-" && p.as_os_str() == "-" {
+                    // The SVG and the PNG would run together on stdout.
+                    return Err(Failure::Usage(
+                        "--preview - and -o - both name standard output".into(),
+                    ));
+                }
                 if out.as_os_str() != "-" && io::same_file(out, p) {
                     return Err(Failure::Usage("--preview and -o name the same file".into()));
                 }
@@ -624,6 +651,10 @@ fn run_diff(args: DiffArgs, quiet: bool) -> Result<(), Failure> {
             args.tolerance
         )));
     }
+    if let Some(out) = &args.out {
+        check_not_input(&args.expected, out)?;
+        check_not_input(&args.actual, out)?;
+    }
     let report = diff::diff_files(&args.expected, &args.actual)?;
     if let Some(out) = &args.out {
         diff::write_panels(&report, out)?;
@@ -646,6 +677,14 @@ fn run_style_check(args: StyleCheckArgs, quiet: bool) -> Result<(), Failure> {
     use flourish::style::{self, brush, check};
     let styles_dir = args.styles.unwrap_or_else(style::default_styles_dir);
     let dir = style::resolve(&args.style, &styles_dir)?;
+    if let Some(sheet) = &args.sheet {
+        // The sheet must not replace the style's own files.
+        let toml = style::load(&dir)?;
+        check_not_input(&dir.join(style::STYLE_FILE), sheet)?;
+        for ex in &toml.exemplar {
+            check_not_input(&dir.join(&ex.file), sheet)?;
+        }
+    }
     let opts = brush::AnalysisOptions {
         cache_dir: args.cache,
         use_cache: !args.no_cache,

@@ -412,6 +412,40 @@ fn svg_shapes_with_huge_coordinates_trace_quickly() {
 }
 
 #[test]
+fn svg_long_stroked_path_traces_quickly() {
+    // A spiral polyline of 100 000 points: its stroke outline's every
+    // segment read every other segment for its winding number (40 000
+    // points took 15 s, 100 000 about 90 s); now under a second or two.
+    let t = tempdir();
+    let n = 100_000;
+    let pts: Vec<String> = (0..n)
+        .map(|i| {
+            let f = i as f64 / n as f64;
+            let (a, r) = (f * 60.0 * std::f64::consts::PI, 5.0 + 90.0 * f);
+            format!("{:.2} {:.2}", 100.0 + r * a.cos(), 100.0 + r * a.sin())
+        })
+        .collect();
+    let p = write(
+        t.path(),
+        "spiral.svg",
+        &format!(
+            r#"<svg xmlns="http://www.w3.org/2000/svg" width="200" height="200">
+<polyline points="{}" fill="none" stroke="black" stroke-width="0.8"/></svg>"#,
+            pts.join(" ")
+        ),
+    );
+    let out = t.path().join("out.svg");
+    let (o, took) = flourish_timed(
+        t.path(),
+        &["trace", s(&p), "-o", s(&out)],
+        Duration::from_secs(60),
+    );
+    assert!(o.status.success(), "stderr: {}", stderr(&o));
+    assert!(took < Duration::from_secs(20), "took {took:?}");
+    assert!(std::fs::read_to_string(&out).unwrap().contains("<path"));
+}
+
+#[test]
 fn missing_input_fails_cleanly() {
     let t = tempdir();
     let p = t.path().join("does-not-exist.png");
@@ -428,6 +462,27 @@ fn directory_as_input_fails_cleanly() {
 
 // ---------------------------------------------------------------------------
 // trace: degenerate but valid inputs
+
+#[test]
+fn endless_device_as_input_fails_at_the_size_limit() {
+    // /dev/zero has no length to check beforehand: it was read until memory
+    // ran out (gigabytes). Reading stops at the file size limit instead.
+    let dev = Path::new("/dev/zero");
+    if !dev.exists() {
+        return;
+    }
+    let t = tempdir();
+    let out = t.path().join("out.svg");
+    for cmd in ["trace", "fill"] {
+        let (o, _) = flourish_timed(
+            t.path(),
+            &[cmd, s(dev), "-o", s(&out)],
+            Duration::from_secs(30),
+        );
+        assert_failure(&o, dev, &["limit"]);
+        assert!(!out.exists());
+    }
+}
 
 #[test]
 fn all_white_image_gives_valid_empty_svg() {
@@ -868,6 +923,8 @@ fn bad_min_area_resolution_threads_are_usage_errors() {
         (vec!["--resolution", "0"], "resolution"),
         (vec!["--resolution=-5"], "resolution"),
         (vec!["--threads", "0"], "threads"),
+        // Each would be a thread: a million of them never got started.
+        (vec!["--threads", "1000000"], "threads"),
     ] {
         let mut full = vec!["trace", s(&a), "-o", s(&out)];
         full.extend(args.iter().copied());
@@ -1345,6 +1402,26 @@ fn diff_out_in_missing_folder_fails_cleanly() {
     assert!(!d.exists());
 }
 
+#[test]
+fn diff_out_equal_to_an_input_is_refused() {
+    // `diff a.svg b.svg --out b.svg` wrote the panels PNG over b.svg.
+    let t = tempdir();
+    let a = write(t.path(), "a.svg", SQUARE_SVG);
+    let b = write(t.path(), "b.svg", SQUARE_SVG_MOVED);
+    for (out, text) in [(&a, SQUARE_SVG), (&b, SQUARE_SVG_MOVED)] {
+        let o = flourish(&["diff", s(&a), s(&b), "--out", s(out)]);
+        assert_failure(&o, out, &["overwrite"]);
+        assert_eq!(std::fs::read_to_string(out).unwrap(), text, "input changed");
+        assert!(o.stdout.is_empty(), "stdout: {}", stdout(&o));
+    }
+    // Through another spelling of the same path.
+    let other = t.path().join(".").join("b.svg");
+    let o = flourish(&["diff", s(&a), s(&b), "--out", s(&other)]);
+    assert_failure(&o, &b, &["overwrite"]);
+    assert_eq!(std::fs::read_to_string(&b).unwrap(), SQUARE_SVG_MOVED);
+    assert_no_temp_files(t.path());
+}
+
 // ---------------------------------------------------------------------------
 // Previews and file modes
 
@@ -1397,6 +1474,17 @@ fn preview_equal_to_output_is_refused() {
         "stderr: {}",
         stderr(&o)
     );
+}
+
+#[test]
+fn preview_and_output_both_on_stdout_is_refused() {
+    // `-o - --preview -` wrote the SVG and then the PNG to stdout, run
+    // together into one corrupt stream.
+    let t = tempdir();
+    let a = t.path().join("a.png");
+    write_disc_png(&a, 20);
+    let o = flourish(&["trace", s(&a), "-o", "-", "--preview", "-"]);
+    assert_usage(&o, "standard output");
 }
 
 #[test]
@@ -1545,4 +1633,173 @@ fn brush_variations_with_out_dir_name_each_variation() {
     }
     let o = flourish(&["brush", "--style", "doodle", s(&a), "--variations", "2"]);
     assert_usage(&o, "--variations");
+}
+
+#[test]
+fn brush_iterations_out_of_range_is_a_usage_error() {
+    // `--iterations 1000000000` ran a billion correction passes (a hang).
+    let t = tempdir();
+    let a = write(
+        t.path(),
+        "wave.svg",
+        r##"<svg xmlns="http://www.w3.org/2000/svg" width="200" height="100">
+<path d="M20 50 C 60 10, 140 90, 180 50" fill="none" stroke="#000" stroke-width="20"/>
+</svg>"##,
+    );
+    let out = t.path().join("out.svg");
+    let (o, _) = flourish_timed(
+        t.path(),
+        &[
+            "brush",
+            "--style",
+            "doodle",
+            s(&a),
+            "-o",
+            s(&out),
+            "--iterations",
+            "1000000000",
+        ],
+        Duration::from_secs(60),
+    );
+    assert_usage(&o, "--iterations");
+    assert!(!out.exists());
+}
+
+#[test]
+fn brush_memory_does_not_grow_with_the_number_of_strokes() {
+    // Every query's synthesized fields (~2 MB for a short stroke, ~18 MB
+    // for a long one) were kept until the whole sketch was done: 200 tiny
+    // strokes took 540 MB, 5000 ran out of memory and aborted. Now each
+    // query's fields go once it is traced. Run under a 400 MB address
+    // space limit (the run itself needs about 130 MB).
+    let t = tempdir();
+    let mut body = String::new();
+    for i in 0..200 {
+        let (x, y) = (10.0 + (i % 20) as f64 * 9.0, 10.0 + (i / 20) as f64 * 9.0);
+        body.push_str(&format!(
+            r##"<path d="M{x} {y} l0.3 0.2" fill="none" stroke="#000" stroke-width="0.5"/>"##
+        ));
+    }
+    let a = write(
+        t.path(),
+        "many.svg",
+        &format!(
+            r##"<svg xmlns="http://www.w3.org/2000/svg" width="200" height="200">{body}</svg>"##
+        ),
+    );
+    let out = t.path().join("out.svg");
+    let cache = t.path().join("cache");
+    let o = Command::new("sh")
+        .arg("-c")
+        .arg(r#"ulimit -v 400000 && exec "$0" "$@""#)
+        .arg(BIN)
+        .args([
+            "--threads",
+            "2",
+            "brush",
+            "--style",
+            "doodle",
+            "--cache",
+            s(&cache),
+            s(&a),
+            "-o",
+            s(&out),
+        ])
+        .stdin(Stdio::null())
+        .output()
+        .expect("run flourish");
+    assert_eq!(code(&o), Some(0), "stderr: {}", stderr(&o));
+    let svg = std::fs::read(&out).unwrap();
+    let tree = parse_output(&svg).expect("output parses");
+    assert_eq!(tree.root().children().len(), 200, "one group per stroke");
+}
+
+#[test]
+fn data_style_reads_only_the_styles_folder() {
+    // A shape's data-style="/abs/folder" (or "../x") was read as a folder
+    // path, so a sketch could make flourish read any folder's style.toml
+    // and exemplars; a missing one was reported without the sketch's name.
+    let t = tempdir();
+    let styles = t.path().join("styles");
+    std::fs::create_dir(&styles).unwrap();
+    let shipped = flourish::style::default_styles_dir();
+    for (cmd, style) in [("pattern", "stipple"), ("fill", "knot")] {
+        let outside = shipped.join(style);
+        for (name, cause) in [
+            (s(&outside).to_string(), "not a style name"),
+            (format!("../{style}"), "not a style name"),
+            (String::new(), "not a style name"),
+            ("missing".to_string(), "not found"),
+        ] {
+            let a = write(
+                t.path(),
+                "shape.svg",
+                &format!(
+                    r##"<svg xmlns="http://www.w3.org/2000/svg" width="200" height="200">
+<circle cx="100" cy="100" r="80" fill="#ccc" data-style="{name}"/></svg>"##
+                ),
+            );
+            let out = t.path().join("out.svg");
+            let o = flourish(&[
+                cmd,
+                "--styles",
+                s(&styles),
+                "--style",
+                s(&outside),
+                s(&a),
+                "-o",
+                s(&out),
+            ]);
+            assert_failure(&o, &a, &["data-style", cause]);
+            assert!(!out.exists(), "{cmd} {name:?}: output written");
+        }
+    }
+}
+
+#[test]
+fn brush_thin_diagonal_stroke_is_refused_at_the_canvas_limit() {
+    // One stroke 1.45 units wide across a 200-unit sketch: a 7900×7900 px
+    // canvas (under the general 64 Mpx limit) on which the synthesis took
+    // over 7 GB and aborted ("memory allocation failed", exit 134).
+    let t = tempdir();
+    let a = write(
+        t.path(),
+        "diagonal.svg",
+        r##"<svg xmlns="http://www.w3.org/2000/svg" width="200" height="200">
+<path d="M2 2 L198 198" fill="none" stroke="#000" stroke-width="1.45"/></svg>"##,
+    );
+    let out = t.path().join("out.svg");
+    let cache = std::env::temp_dir().join("flourish-test-cache");
+    let (o, _) = flourish_timed(
+        t.path(),
+        &[
+            "brush",
+            "--style",
+            "vine",
+            "--cache",
+            s(&cache),
+            s(&a),
+            "-o",
+            s(&out),
+        ],
+        Duration::from_secs(30),
+    );
+    assert_failure(&o, &a, &["size limit", "wider"]);
+    assert!(!out.exists());
+}
+
+#[test]
+fn file_name_with_a_newline_is_named_on_one_line() {
+    // "new\nline.svg" was printed as is: a two-line error.
+    let t = tempdir();
+    let p = write(t.path(), "new\nline.svg", "not an svg");
+    let out = t.path().join("out.svg");
+    for cmd in ["trace", "pattern"] {
+        let o = flourish(&[cmd, s(&p), "-o", s(&out)]);
+        assert_eq!(code(&o), Some(1), "stderr: {}", stderr(&o));
+        let err = stderr(&o);
+        assert_eq!(err.lines().count(), 1, "{err:?}");
+        assert!(err.contains("new\\nline.svg"), "{err:?}");
+        assert!(!out.exists());
+    }
 }

@@ -409,3 +409,28 @@ fn png_exemplars_are_analysed_too() {
     assert!(ex.extension[1] > 10.0, "{:?}", ex.extension);
     assert!(st.indexes.iter().all(|i| !i.is_empty()));
 }
+
+#[test]
+fn sheet_over_a_file_of_the_style_is_refused() {
+    // `--sheet STYLE/style.toml` wrote the PNG over the style's own file.
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("wavy");
+    small_style(&dir, TOML);
+    for name in ["style.toml", "a.svg"] {
+        let target = dir.join(name);
+        let before = std::fs::read(&target).unwrap();
+        let out = flourish(&[
+            "style",
+            "check",
+            s(&dir),
+            "--no-cache",
+            "--sheet",
+            s(&target),
+        ]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(err.contains(name) && err.contains("overwrite"), "{err}");
+        assert_eq!(std::fs::read(&target).unwrap(), before, "{name} changed");
+    }
+}

@@ -390,92 +390,94 @@ pub fn prepared_spines(
     Ok((spines, set.warnings, notes))
 }
 
-/// Applies a refinement sketch to every synthesized query (§5.5): the
-/// sketch is rendered onto each query's canvas; opaque dark pixels add ink,
-/// opaque light ones erase it; the mask is those pixels dilated by 2 px.
-fn refine_all(
+/// Applies a refinement sketch (already parsed, `tree`) to one synthesized
+/// query (§5.5): the sketch is rendered onto the query's canvas; opaque dark
+/// pixels add ink, opaque light ones erase it; the mask is those pixels
+/// dilated by 2 px.
+fn refine_one(
     style: &BrushStyle,
-    results: Vec<QueryResult>,
-    path: &std::path::Path,
+    mut r: QueryResult,
+    tree: &resvg::usvg::Tree,
     opts: &BrushOptions,
-) -> Result<Vec<QueryResult>> {
-    let tree = crate::io::load_svg(path)?;
+) -> QueryResult {
     let sopts = crate::brush::synth::SynthOptions {
         seed: opts.seed,
         ..opts.synth.clone()
     };
-    let mut out = Vec::with_capacity(results.len());
-    for mut r in results {
-        let (w, h) = (r.canvas.width, r.canvas.height);
-        let Some(mut pixmap) = resvg::tiny_skia::Pixmap::new(w as u32, h as u32) else {
-            out.push(r);
-            continue;
-        };
-        let c = r.canvas.to_pixel(1.0).as_coeffs();
-        let t = resvg::tiny_skia::Transform::from_row(
-            c[0] as f32,
-            c[1] as f32,
-            c[2] as f32,
-            c[3] as f32,
-            c[4] as f32,
-            c[5] as f32,
-        );
-        resvg::render(&tree, t, &mut pixmap.as_mut());
-        let px = pixmap.pixels();
-        // +1 add, −1 erase, 0 untouched.
-        let marks = Grid::from_fn(w, h, |x, y| {
-            let p = px[y * w + x];
-            if p.alpha() < 128 {
-                0i8
+    let (w, h) = (r.canvas.width, r.canvas.height);
+    let Some(mut pixmap) = resvg::tiny_skia::Pixmap::new(w as u32, h as u32) else {
+        return r;
+    };
+    let c = r.canvas.to_pixel(1.0).as_coeffs();
+    let t = resvg::tiny_skia::Transform::from_row(
+        c[0] as f32,
+        c[1] as f32,
+        c[2] as f32,
+        c[3] as f32,
+        c[4] as f32,
+        c[5] as f32,
+    );
+    resvg::render(tree, t, &mut pixmap.as_mut());
+    let px = pixmap.pixels();
+    // +1 add, −1 erase, 0 untouched.
+    let marks = Grid::from_fn(w, h, |x, y| {
+        let p = px[y * w + x];
+        if p.alpha() < 128 {
+            0i8
+        } else {
+            let l = (p.red() as u32 + p.green() as u32 + p.blue() as u32) * 255
+                / (3 * p.alpha() as u32).max(1);
+            if l < 128 {
+                1
             } else {
-                let l = (p.red() as u32 + p.green() as u32 + p.blue() as u32) * 255
-                    / (3 * p.alpha() as u32).max(1);
-                if l < 128 {
-                    1
-                } else {
-                    -1
-                }
-            }
-        });
-        if marks.data().iter().all(|m| *m == 0) {
-            out.push(r);
-            continue;
-        }
-        let mut target = crate::brush::synth::appearance(style, &r.field);
-        let mask = Grid::from_fn(w, h, |x, y| {
-            (-2isize..=2).any(|dy| {
-                (-2isize..=2).any(|dx| marks.get_or(x as isize + dx, y as isize + dy, 0) != 0)
-            })
-        });
-        for y in 0..h {
-            for x in 0..w {
-                match marks.get(x, y) {
-                    1 => target.set(x, y, -2.0),
-                    -1 => target.set(x, y, PAPER),
-                    _ => {}
-                }
+                -1
             }
         }
-        if let Some(f) = crate::brush::synth::refine(style, &r.levels, &target, &mask, &sopts) {
-            r.field = f;
-        }
-        out.push(r);
+    });
+    if marks.data().iter().all(|m| *m == 0) {
+        return r;
     }
-    Ok(out)
+    let mut target = crate::brush::synth::appearance(style, &r.field);
+    let mask = Grid::from_fn(w, h, |x, y| {
+        (-2isize..=2).any(|dy| {
+            (-2isize..=2).any(|dx| marks.get_or(x as isize + dx, y as isize + dy, 0) != 0)
+        })
+    });
+    for y in 0..h {
+        for x in 0..w {
+            match marks.get(x, y) {
+                1 => target.set(x, y, -2.0),
+                -1 => target.set(x, y, PAPER),
+                _ => {}
+            }
+        }
+    }
+    if let Some(f) = crate::brush::synth::refine(style, &r.levels, &target, &mask, &sopts) {
+        r.field = f;
+    }
+    r
 }
 
 /// Runs the brush pipeline on every open path of `sketch` (queries in
-/// parallel, results in drawing order) and writes the document.
+/// parallel, results in drawing order) and writes the document. Each query
+/// is synthesized, refined and traced in one go, so with
+/// [`BrushOptions::discard_fields`] only the queries in flight hold their
+/// fields.
 pub fn brush_sketch(
     style: &BrushStyle,
     sketch: &Sketch,
     opts: &BrushOptions,
 ) -> Result<BrushOutput> {
     let (spines, warnings, notes) = prepared_spines(sketch, opts)?;
-    let results: Vec<QueryResult> = spines
+    let refine = match &opts.refine {
+        Some(path) => Some(crate::io::load_svg(path)?),
+        None => None,
+    };
+    let trace = TraceOptions::default();
+    let done: Vec<(QueryResult, Group)> = spines
         .par_iter()
         .map(|q| {
-            brush_query(style, q, opts).map_err(|e| match e {
+            let r = brush_query(style, q, opts).map_err(|e| match e {
                 Error::TooLarge {
                     width,
                     height,
@@ -492,17 +494,32 @@ pub fn brush_sketch(
                     reason,
                 },
                 other => other,
-            })
+            })?;
+            let mut r = match &refine {
+                Some(tree) => refine_one(style, r, tree, opts),
+                None => r,
+            };
+            let id = if r.spine.query_id.is_empty() {
+                "q".to_string()
+            } else {
+                r.spine.query_id.clone()
+            };
+            let group = trace_query(style, &r, id, &trace);
+            if opts.discard_fields {
+                r.field = Field {
+                    level: r.field.level,
+                    coords: Grid::new(0, 0, None),
+                    orient: Grid::new(0, 0, [0.0; 2]),
+                    seam: Grid::new(0, 0, false),
+                };
+                r.levels = Vec::new();
+            }
+            Ok((r, group))
         })
         .collect::<Result<Vec<_>>>()?;
-    let results = match &opts.refine {
-        Some(path) => refine_all(style, results, path, opts)?,
-        None => results,
-    };
-    let trace = TraceOptions::default();
-    let ppu = results
+    let ppu = done
         .iter()
-        .map(|r| r.canvas.px_per_unit)
+        .map(|(r, _)| r.canvas.px_per_unit)
         .fold(0.0f64, f64::max);
     let mut document = Document::new(
         sketch.width,
@@ -510,19 +527,10 @@ pub fn brush_sketch(
         decimals_for(trace.tolerance / ppu.max(1e-9)),
     );
     document.view_box = sketch.view_box;
-    let groups: Vec<Group> = results
-        .par_iter()
-        .map(|r| {
-            let id = if r.spine.query_id.is_empty() {
-                "q".to_string()
-            } else {
-                r.spine.query_id.clone()
-            };
-            trace_query(style, r, id, &trace)
-        })
-        .collect();
+    let mut results = Vec::with_capacity(done.len());
     // Subpaths of one query share its group.
-    for g in groups {
+    for (r, g) in done {
+        results.push(r);
         match document.groups.last_mut() {
             Some(last) if last.id == g.id => last.shapes.extend(g.shapes),
             _ => document.groups.push(g),

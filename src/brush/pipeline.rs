@@ -50,6 +50,13 @@ pub struct BrushOptions {
     /// A refinement sketch (§5.5, `--refine`): black strokes add ink,
     /// white ones erase it; same viewBox as the sketch.
     pub refine: Option<std::path::PathBuf>,
+    /// Drop each query's synthesized fields once it is traced: the
+    /// [`QueryResult`]s of [`crate::brush::output::BrushOutput`] keep their
+    /// spine, canvas and segments but an empty `field` and no `levels`, so
+    /// a sketch of thousands of strokes needs the memory of the few being
+    /// synthesized at a time, not of all of them (about 18 MB each for a
+    /// 556×556 px canvas). The document is the same either way.
+    pub discard_fields: bool,
 }
 
 /// A query's canvas: finest-level pixel `(x, y)` has its centre at sketch
@@ -124,11 +131,20 @@ pub fn start_level(style: &BrushStyle, ew: f64) -> usize {
         .unwrap_or(e.levels.len().saturating_sub(1))
 }
 
+/// Largest canvas of one brush query, pixels in all (16 Mpx). Synthesis
+/// and tracing hold about 115 bytes per canvas pixel (fields of every
+/// level, Jacobians, layer SDFs), so the general 64 Mpx canvas limit let a
+/// thin diagonal stroke (one 1.45 units wide across a 200-unit sketch, a
+/// 7900×7900 px canvas) take over 7 GB and abort; 16 Mpx is about 1.8 GB,
+/// twenty times the largest canvas of the shipped samples.
+pub const MAX_BRUSH_PIXELS: u64 = 16 << 20;
+
 /// The canvas of a query spine: its bounding box grown by 1.5 stroke
 /// widths (the farthest an ornament may reach from its spine; with one
 /// width, end curls and outer leaves were cut flat on the canvas border),
 /// at `W_e / W_q` finest pixels per unit, a whole number of coarsest
-/// pixels; checked against the canvas limits before anything is allocated.
+/// pixels; checked against the canvas limits (and [`MAX_BRUSH_PIXELS`])
+/// before anything is allocated.
 pub fn canvas_for(q: &QuerySpine, ew: f64, factor: usize) -> Result<Canvas> {
     let ppu = ew / q.width;
     let (mut x0, mut y0, mut x1, mut y1) = (f64::MAX, f64::MAX, f64::MIN, f64::MIN);
@@ -148,11 +164,22 @@ pub fn canvas_for(q: &QuerySpine, ew: f64, factor: usize) -> Result<Canvas> {
     if !(cw.is_finite() && ch.is_finite() && cw >= 1.0 && ch >= 1.0) {
         return Err(Error::invalid(what, "the stroke gives an empty canvas"));
     }
-    crate::io::check_canvas(
-        what,
+    let (width, height) = (
         (cw * f).min(u64::MAX as f64) as u64,
         (ch * f).min(u64::MAX as f64) as u64,
-    )?;
+    );
+    crate::io::check_canvas(what, width, height)?;
+    if width.saturating_mul(height) > MAX_BRUSH_PIXELS {
+        return Err(Error::TooLarge {
+            path: what.to_path_buf(),
+            width,
+            height,
+            limit: format!(
+                "{} Mpx in all for a brush stroke; draw the stroke wider or shorter",
+                MAX_BRUSH_PIXELS >> 20
+            ),
+        });
+    }
     Ok(Canvas {
         origin: Point::new(x0 - m, y0 - m),
         px_per_unit: ppu,

@@ -291,7 +291,10 @@ pub fn fill_sketch(opts: &FillOptions, sk: &Sketch) -> Result<FillOutput> {
     for (qi, (q, outline, rule)) in regions.into_iter().enumerate() {
         let name = q.style.clone().unwrap_or_else(|| opts.style.clone());
         if !styles.contains_key(&name) {
-            let dir = style::resolve(&name, &opts.styles_dir)?;
+            let dir = match &q.style {
+                Some(ds) => style::resolve_data_style(&sk.path, &q.id, ds, &opts.styles_dir)?,
+                None => style::resolve(&name, &opts.styles_dir)?,
+            };
             styles.insert(name.clone(), FillStyle::load(&dir, opts.resolution)?);
         }
         let st = &styles[&name];

@@ -326,7 +326,10 @@ pub fn synthesize_sketch(opts: &PatternOptions, sk: &Sketch) -> Result<PatternOu
     for q in &sk.queries {
         let name = q.style.as_deref().unwrap_or(&opts.style);
         if !styles.contains_key(name) {
-            let dir = style::resolve(name, &opts.styles_dir)?;
+            let dir = match &q.style {
+                Some(ds) => style::resolve_data_style(&sk.path, &q.id, ds, &opts.styles_dir)?,
+                None => style::resolve(name, &opts.styles_dir)?,
+            };
             styles.insert(name, Arc::new(PatternStyle::load(&dir)?));
         }
     }

@@ -361,6 +361,41 @@ pub fn resolve(style: &str, styles_dir: &Path) -> Result<PathBuf> {
     ))
 }
 
+/// Finds the folder of a sketch shape's `data-style="NAME"`: NAME must be
+/// a bare name (no folder separators, not `.` or `..`) and is looked up in
+/// `styles_dir` only, so a sketch cannot make flourish read files outside
+/// the styles folder (`data-style="/etc"`, `"../../x"`). Errors name the
+/// sketch file and the query.
+pub fn resolve_data_style(
+    sketch: &Path,
+    query_id: &str,
+    name: &str,
+    styles_dir: &Path,
+) -> Result<PathBuf> {
+    let mut parts = Path::new(name).components();
+    let bare = matches!(
+        (parts.next(), parts.next()),
+        (Some(std::path::Component::Normal(n)), None) if n == std::ffi::OsStr::new(name)
+    );
+    if !bare {
+        return Err(Error::invalid(
+            sketch,
+            format!("{query_id}: data-style \"{name}\" is not a style name (a folder name in {}, without slashes)", styles_dir.display()),
+        ));
+    }
+    let dir = styles_dir.join(name);
+    if dir.join(STYLE_FILE).is_file() {
+        return Ok(dir);
+    }
+    Err(Error::invalid(
+        sketch,
+        format!(
+            "{query_id}: data-style \"{name}\": style not found: {} does not exist",
+            dir.join(STYLE_FILE).display()
+        ),
+    ))
+}
+
 /// The styles shipped with the tool (the crate's `styles/` folder).
 pub fn default_styles_dir() -> PathBuf {
     PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/styles"))
@@ -369,6 +404,44 @@ pub fn default_styles_dir() -> PathBuf {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A shape's `data-style` is a name in the styles folder, never a
+    /// path: absolute, relative, parent and empty names are refused with
+    /// the sketch and query named; a missing name says so.
+    #[test]
+    fn data_style_is_a_name_in_the_styles_folder() {
+        let styles = default_styles_dir();
+        let sketch = Path::new("sketch.svg");
+        assert_eq!(
+            resolve_data_style(sketch, "q-1", "knot", &styles).expect("shipped"),
+            styles.join("knot")
+        );
+        for bad in [
+            "/etc",
+            "../styles/knot",
+            "knot/",
+            "./knot",
+            "..",
+            ".",
+            "",
+            "a/b",
+        ] {
+            let e = resolve_data_style(sketch, "q-1", bad, &styles)
+                .expect_err(bad)
+                .to_string();
+            assert!(
+                e.starts_with("sketch.svg: q-1: data-style") && !e.contains('\n'),
+                "{bad:?}: {e}"
+            );
+        }
+        let e = resolve_data_style(sketch, "q-2", "no-such-style", &styles)
+            .expect_err("missing")
+            .to_string();
+        assert!(
+            e.starts_with("sketch.svg: q-2: data-style \"no-such-style\": style not found"),
+            "{e}"
+        );
+    }
 
     #[test]
     fn pattern_style_parses() {
