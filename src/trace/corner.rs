@@ -30,7 +30,7 @@ const EXCESS: f64 = 0.4;
 
 /// Indices of the corner vertices of a closed polygon: turning by more
 /// than `CORNER_ANGLE` within ±`CORNER_WINDOW` px, the sharpest vertex
-/// of each such stretch, and by [`EXCESS`] more than a circle of the
+/// of each such stretch, and by `EXCESS` (0.4 rad) more than a circle of the
 /// loop's length: a dot of the 2 Mpx ornament's dotted rings (1–1.5 px
 /// across) was an octagon of lines between corners found wherever its
 /// outline's wobble peaked, and is now two or three cubics, while a 4-px
