@@ -343,8 +343,22 @@ fn link_crossing(cov: &Coverage, l: Link, thin: Option<(&Grid<bool>, &ThinRuns)>
         return (clamp_t(t), true);
     }
     let e = l.direction();
-    let m0 = edge_model(cov, x0, y0);
-    let m1 = edge_model(cov, x1, y1);
+    // The ink lies ahead along the link when its second end is inside. An
+    // outside pixel whose edge model's normal (into its ink) points back
+    // away from the inside end holds the edge of something beyond it, not
+    // the one crossed here: the faint underside of a line a pixel above a
+    // dot put the dot's top at the faint pixel's centre, a spike a pixel
+    // long (the 2 Mpx anti-aliased ornament's dotted rings).
+    let inside_at = |x: i32, y: i32| {
+        thin.map_or(cov.get(x as usize, y as usize) >= 0.5, |(inside, _)| {
+            inside.get_or(x as isize, y as isize, false)
+        })
+    };
+    let (in0, in1) = (inside_at(x0, y0), inside_at(x1, y1));
+    let ahead = if in1 && !in0 { 1.0 } else { -1.0 };
+    let own_edge = |m: &EdgeModel, inside: bool| inside || m.n.dot(e) * ahead > -0.5;
+    let m0 = edge_model(cov, x0, y0).filter(|m| own_edge(m, in0));
+    let m1 = edge_model(cov, x1, y1).filter(|m| own_edge(m, in1));
     let oblique = |m: &EdgeModel| m.n.dot(e).abs() > 0.2;
     let t = match (m0, m1) {
         (Some(a), Some(b)) if a.d * b.d <= 0.0 && a.d != b.d => Some(a.d / (a.d - b.d)),
@@ -679,6 +693,53 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A dot a pixel below a thin line (the 2 Mpx anti-aliased ornament's
+    /// dotted ring, as rendered): the faint pixel between them holds the
+    /// line's underside, and its edge model, facing the line, once put the
+    /// dot's top at that pixel's centre, a spike a pixel long. The dot's
+    /// outline now stays on its own side of the gap, and the line's
+    /// underside where it was.
+    #[test]
+    fn a_dot_under_a_line_is_not_drawn_up_to_it() {
+        // Darkness 0..=255, rows 3..=11 of columns 5..=14 of the render.
+        let rows: [[u8; 10]; 9] = [
+            [0, 0, 0, 0, 0, 0, 0, 0, 0, 0],
+            [0, 0, 0, 0, 0, 0, 0, 0, 0, 0],
+            [0, 0, 0, 0, 0, 0, 0, 16, 63, 63],
+            [48, 95, 127, 191, 223, 255, 255, 255, 224, 192],
+            [224, 192, 128, 80, 48, 0, 0, 0, 0, 0],
+            [0, 0, 0, 32, 127, 32, 0, 0, 0, 0],
+            [0, 0, 0, 192, 255, 176, 0, 0, 0, 0],
+            [0, 0, 0, 144, 255, 112, 0, 0, 0, 0],
+            [0, 0, 0, 0, 0, 0, 0, 0, 0, 0],
+        ];
+        let cov = Grid::from_fn(10, 9, |x, y| f32::from(rows[y][x]) / 255.0);
+        let polys = subpixel_outline(&cov);
+        // The dot: the loop whose points all lie below the line's rows.
+        let dot = polys
+            .iter()
+            .find(|p| p.iter().all(|q| q.y > 4.5))
+            .expect("the dot is a loop of its own");
+        let top = dot.iter().map(|q| q.y).fold(f64::INFINITY, f64::min);
+        // Its top pixel (column 4, row 5) is half covered: the top edge is
+        // near that pixel's centre (y = 5.5), not at the faint pixel's (4.5).
+        assert!(top > 5.2, "dot's top at y = {top:.2}");
+        // The line's underside over the dot stays a pixel above it.
+        let line = polys
+            .iter()
+            .find(|p| p.iter().any(|q| q.y < 3.5))
+            .expect("the line");
+        let under = line
+            .iter()
+            .filter(|q| (q.x - 4.5).abs() < 0.01 && q.y > 3.5)
+            .map(|q| q.y)
+            .fold(f64::NEG_INFINITY, f64::max);
+        assert!(
+            (under - 4.1).abs() < 0.2,
+            "line's underside at y = {under:.2}"
+        );
     }
 
     #[test]
