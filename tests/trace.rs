@@ -932,3 +932,65 @@ fn a_photographed_drawing_traces_as_the_drawing_under_uneven_light() {
         assert!(scores[1] >= scores[0] - 0.015, "{name}.{ext}: {scores:?}");
     }
 }
+
+/// `--layers` on a colour drawing photographed under uneven light (the
+/// light falling to 0.4 in one corner): the same layers in the same
+/// colours, within 3 levels a channel, and the same shapes in each as the
+/// evenly lit drawing gives, the dim corner's ink read as its colour and
+/// not as a darker one of its own.
+#[test]
+fn layers_of_a_photographed_colour_drawing_are_its_colours() {
+    let path = root().join("samples/trace/two-colour.png");
+    let img = image::open(&path).expect("png").to_rgb8();
+    let (w, h) = img.dimensions();
+    let photo = image::RgbImage::from_fn(w, h, |x, y| {
+        let (u, v) = (x as f64 / w as f64 - 0.3, y as f64 / h as f64 - 0.35);
+        let light = 1.0 - 0.6 * ((u * u + v * v) / 0.75).min(1.0);
+        let p = img.get_pixel(x, y);
+        image::Rgb([0, 1, 2].map(|k| (f64::from(p[k]) * light).round() as u8))
+    });
+    let dir = tempfile::tempdir().unwrap();
+    let lit = dir.path().join("photo.png");
+    photo.save(&lit).unwrap();
+    let input = InputOptions {
+        layers: true,
+        ..InputOptions::default()
+    };
+    let shapes = |p: &Path| -> Vec<(String, usize)> {
+        let doc = trace_file(p, &input, &TraceOptions::default()).expect("traces");
+        let svg = doc.to_svg();
+        let mut fills: Vec<String> = svg
+            .split("fill=\"#")
+            .skip(1)
+            .filter_map(|s| s.split('"').next().map(str::to_string))
+            .collect();
+        fills.sort();
+        let mut out: Vec<(String, usize)> = Vec::new();
+        for f in fills {
+            match out.last_mut() {
+                Some((g, n)) if *g == f => *n += 1,
+                _ => out.push((f, 1)),
+            }
+        }
+        out
+    };
+    let (even, uneven) = (shapes(&path), shapes(&lit));
+    assert_eq!(even.len(), uneven.len(), "{even:?} vs {uneven:?}");
+    // `#rrggbb`, or `#rgb` as the writer shortens it.
+    let rgb = |s: &str| {
+        let long: String = if s.len() == 3 {
+            s.chars().flat_map(|c| [c, c]).collect()
+        } else {
+            s.to_string()
+        };
+        [0, 2, 4].map(|k| i32::from_str_radix(&long[k..k + 2], 16).expect("hex colour"))
+    };
+    for ((a, n), (b, m)) in even.iter().zip(&uneven) {
+        let (ca, cb) = (rgb(a), rgb(b));
+        assert!(
+            ca.iter().zip(&cb).all(|(x, y)| (x - y).abs() <= 3),
+            "#{a} vs #{b}"
+        );
+        assert_eq!(n, m, "shapes in #{a}");
+    }
+}
