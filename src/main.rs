@@ -268,7 +268,7 @@ fn run(cli: Cli) -> Result<(), Failure> {
             .map_err(|e| Failure::Usage(format!("--threads: {e}")))?;
     }
     match cli.command {
-        Command::Trace(args) => run_trace(args, cli.quiet),
+        Command::Trace(args) => run_trace(args, cli.quiet, cli.verbose),
         Command::Pattern(args) => run_pattern(args, cli.quiet, cli.verbose),
         Command::Fill(args) => run_fill(args, cli.quiet, cli.verbose),
         Command::Brush(args) => run_brush(args, cli.quiet, cli.verbose),
@@ -279,7 +279,7 @@ fn run(cli: Cli) -> Result<(), Failure> {
     }
 }
 
-fn run_trace(args: TraceArgs, quiet: bool) -> Result<(), Failure> {
+fn run_trace(args: TraceArgs, quiet: bool, verbose: bool) -> Result<(), Failure> {
     let input = InputOptions {
         resolution: args.resolution,
         invert: args.invert,
@@ -298,6 +298,11 @@ fn run_trace(args: TraceArgs, quiet: bool) -> Result<(), Failure> {
         if !quiet {
             for w in &doc.warnings {
                 eprintln!("flourish: warning: {}: {w}", inp.display());
+            }
+        }
+        if verbose {
+            for note in &doc.notes {
+                eprintln!("flourish: {}: {note}", inp.display());
             }
         }
         Ok(doc.to_svg())

@@ -143,6 +143,9 @@ pub struct Document {
     /// What the input held that the document leaves out, one line each
     /// (not written to the SVG; the command line prints them).
     pub warnings: Vec<String>,
+    /// What was done to the input on the way, one line each (not written
+    /// to the SVG; the command line prints them under `--verbose`).
+    pub notes: Vec<String>,
 }
 
 /// The number of decimals needed so that rounding moves a point by at most a
@@ -165,6 +168,7 @@ impl Document {
             groups: Vec::new(),
             decimals,
             warnings: Vec::new(),
+            notes: Vec::new(),
         }
     }
 

@@ -1803,3 +1803,39 @@ fn file_name_with_a_newline_is_named_on_one_line() {
         assert!(!out.exists());
     }
 }
+
+/// A photo's uneven light is evened out quietly; `-v` says so, on one
+/// line naming the file, and an evenly lit picture says nothing.
+#[test]
+fn verbose_trace_says_when_a_photos_light_was_evened_out() {
+    let t = tempdir();
+    let photo = t.path().join("photo.png");
+    // White paper lit from 1 at the left to 0.4 at the right, a black disc.
+    image::GrayImage::from_fn(200, 160, |x, y| {
+        let light = 1.0 - 0.6 * f64::from(x) / 200.0;
+        let ink = (f64::from(x) - 100.0).hypot(f64::from(y) - 80.0) < 30.0;
+        let r = if ink { 20.0 } else { 240.0 };
+        image::Luma([(r * light).round() as u8])
+    })
+    .save(&photo)
+    .unwrap();
+    let out = t.path().join("out.svg");
+    let o = flourish(&["-v", "trace", s(&photo), "-o", s(&out)]);
+    assert!(o.status.success(), "{o:?}");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("photo.png") && err.contains("uneven light evened out"),
+        "{err}"
+    );
+    let o = flourish(&["trace", s(&photo), "-o", s(&out)]);
+    assert!(o.status.success() && o.stderr.is_empty(), "{o:?}");
+    let even = t.path().join("even.png");
+    write_disc_png(&even, 120);
+    let o = flourish(&["-v", "trace", s(&even), "-o", s(&out)]);
+    assert!(o.status.success(), "{o:?}");
+    assert!(
+        !String::from_utf8_lossy(&o.stderr).contains("light"),
+        "{o:?}"
+    );
+}

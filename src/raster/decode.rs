@@ -103,12 +103,13 @@ impl RasterCoverage {
 }
 
 /// Decodes raster bytes into ink coverage: alpha or darkness, one layer or
-/// quantized colour layers.
+/// quantized colour layers; with the uneven light of a photo, when it was
+/// measured and divided out first.
 pub(super) fn raster_coverage(
     path: &Path,
     bytes: &[u8],
     opts: &InputOptions,
-) -> Result<RasterCoverage> {
+) -> Result<(RasterCoverage, Option<Lighting>)> {
     let img = decode_raster(path, bytes)?;
     if let (image::DynamicImage::ImageLuma8(grey), false) = (&img, opts.layers) {
         let (w, h) = (grey.width() as usize, grey.height() as usize);
@@ -118,23 +119,25 @@ pub(super) fn raster_coverage(
         if let Some(light) = Lighting::measure(w, h, luma) {
             let mut even = grey.clone();
             light.flatten_grey(&mut even);
-            return Ok(grey_coverage(&even, opts.invert));
+            return Ok((grey_coverage(&even, opts.invert), Some(light)));
         }
-        return Ok(grey_coverage(grey, opts.invert));
+        return Ok((grey_coverage(grey, opts.invert), None));
     }
     let img = img.to_rgba8();
     let (w, h) = (img.width() as usize, img.height() as usize);
     let mut px: Vec<[u8; 4]> = img.pixels().map(|p| p.0).collect();
+    let mut lighting = None;
     if px.iter().all(|p| p[3] == 255) {
         let at = |x: usize, y: usize| {
             px.get(y * w + x)
                 .map_or(255, |p| (luma(p) * 255.0).round() as u8)
         };
-        if let Some(light) = Lighting::measure(w, h, at) {
+        lighting = Lighting::measure(w, h, at);
+        if let Some(light) = &lighting {
             light.flatten_rgba(&mut px);
         }
     }
-    Ok(pixel_coverage(&px, w, h, opts))
+    Ok((pixel_coverage(&px, w, h, opts), lighting))
 }
 
 /// The ink coverage of `w` × `h` RGBA pixels (not premultiplied), row by

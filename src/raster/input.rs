@@ -110,6 +110,9 @@ pub struct OutlineInk {
     pub height: f64,
     /// The layers, bottom first.
     pub layers: Vec<OutlineLayer>,
+    /// What was done to the picture on the way (a photo's light evened
+    /// out), one line each.
+    pub notes: Vec<String>,
 }
 
 /// One ink layer of an [`OutlineInk`].
@@ -162,7 +165,8 @@ pub fn load_traceable(path: &Path, opts: &InputOptions) -> Result<Traceable> {
     if looks_like_svg(&bytes) {
         return load_svg(path, &bytes, opts).map(Traceable::Field);
     }
-    let (w, h, layers) = match raster_coverage(path, &bytes, opts)? {
+    let (coverage, lighting) = raster_coverage(path, &bytes, opts)?;
+    let (w, h, layers) = match coverage {
         RasterCoverage::Binary { w, h, color, bits } => (
             w,
             h,
@@ -184,12 +188,15 @@ pub fn load_traceable(path: &Path, opts: &InputOptions) -> Result<Traceable> {
         width: w as f64,
         height: h as f64,
         layers,
+        notes: lighting.iter().map(|l| l.note()).collect(),
     }))
 }
 
 /// Raster bytes (PNG, JPEG, …) read from `path` as ink, as [`load`] reads them.
 pub fn load_raster(path: &Path, bytes: &[u8], opts: &InputOptions) -> Result<Ink> {
-    Ok(raster_coverage(path, bytes, opts)?.into_ink(Affine::IDENTITY))
+    Ok(raster_coverage(path, bytes, opts)?
+        .0
+        .into_ink(Affine::IDENTITY))
 }
 
 /// One filled shape of an SVG, in pixel coordinates.

@@ -153,6 +153,15 @@ impl Lighting {
         (self.darkest, self.brightest)
     }
 
+    /// One line for `--verbose`: what was evened out.
+    pub fn note(&self) -> String {
+        format!(
+            "uneven light evened out: the paper measured from {:.0} % to {:.0} % of white",
+            100.0 * self.darkest,
+            100.0 * self.brightest
+        )
+    }
+
     /// The factor pixel (x, y)'s values are multiplied by to light it as
     /// the brightest paper is lit.
     fn gain(&self, x: usize, y: usize) -> f32 {

@@ -353,6 +353,7 @@ pub fn trace_file(path: &Path, input: &InputOptions, opts: &TraceOptions) -> Res
                 };
                 doc.groups.extend(layer_group(i, paths, layer.color));
             }
+            doc.notes = o.notes;
             Ok(doc)
         }
     }
