@@ -268,11 +268,6 @@ pub fn sharpen(pts: Vec<Point>) -> Vec<Point> {
             .then((a.s1 - a.s0).total_cmp(&(b.s1 - b.s0)))
             .then(a.s0.total_cmp(&b.s0))
     });
-    // Whether arc length `s` lies strictly inside `a`'s stretch (mod the loop).
-    let within = |a: &Apex, s: f64| {
-        let d = wrap_once(s - a.s0, arc.total);
-        d > 0.0 && d < a.s1 - a.s0
-    };
     let mut kept: Vec<Apex> = Vec::new();
     for a in found {
         // Neither stretch may reach into the other's stretch or sides.
@@ -299,11 +294,13 @@ pub fn sharpen(pts: Vec<Point>) -> Vec<Point> {
         let mut j = a.first;
         for _ in 1..n {
             j = if j + 1 == n { 0 } else { j + 1 };
-            let s = arc.cum[j];
-            if wrap_once(s - a.s0, arc.total) >= a.s1 - a.s0 {
+            // How far past the stretch's start (mod the loop) vertex j is:
+            // strictly inside until the stretch's end.
+            let d = wrap_once(arc.cum[j] - a.s0, arc.total);
+            if d >= a.s1 - a.s0 {
                 break;
             }
-            inside[j] |= within(a, s);
+            inside[j] |= d > 0.0;
         }
     }
     let mut out = Vec::with_capacity(n);
