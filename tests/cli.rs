@@ -26,8 +26,10 @@ fn flourish(args: &[&str]) -> Output {
         .expect("run flourish")
 }
 
-/// Runs flourish in `dir`, killing it (and failing) after `limit`.
-fn flourish_timed(dir: &Path, args: &[&str], limit: Duration) -> (Output, Duration) {
+/// Runs flourish in `dir`, killing it (and failing) after `limit`: a
+/// guard against a hang, set far above what the run takes on a slow
+/// machine (the tests assert no timings).
+fn flourish_guarded(dir: &Path, args: &[&str], limit: Duration) -> Output {
     let start = Instant::now();
     let mut child = Command::new(BIN)
         .args(args)
@@ -51,8 +53,22 @@ fn flourish_timed(dir: &Path, args: &[&str], limit: Duration) -> (Output, Durati
         }
         std::thread::sleep(Duration::from_millis(20));
     }
-    let elapsed = start.elapsed();
-    (child.wait_with_output().expect("collect output"), elapsed)
+    child.wait_with_output().expect("collect output")
+}
+
+/// Runs flourish with its address space capped at `mib` MiB (`ulimit -v`),
+/// so a run that allocates a huge image dies instead of answering.
+fn flourish_capped(dir: &Path, args: &[&str], mib: u64) -> Output {
+    let script = format!("ulimit -v {} && exec \"$0\" \"$@\"", mib * 1024);
+    Command::new("sh")
+        .arg("-c")
+        .arg(script)
+        .arg(BIN)
+        .args(args)
+        .current_dir(dir)
+        .stdin(Stdio::null())
+        .output()
+        .expect("run flourish under sh")
 }
 
 fn s(p: &Path) -> &str {
@@ -348,16 +364,10 @@ fn huge_declared_png_fails_fast_with_size_limit() {
     let p = t.path().join("huge.png");
     std::fs::write(&p, png_header_only(50_000, 50_000)).unwrap();
     let out = t.path().join("out.svg");
-    let (o, elapsed) = flourish_timed(
-        t.path(),
-        &["trace", s(&p), "-o", s(&out)],
-        Duration::from_secs(30),
-    );
+    // Nothing allocated: the 2.5 GB grey image would not fit in 1 GiB of
+    // address space, and the refusal must come before it.
+    let o = flourish_capped(t.path(), &["trace", s(&p), "-o", s(&out)], 1024);
     assert_failure(&o, &p, &["size limit"]);
-    assert!(
-        elapsed < Duration::from_secs(5),
-        "took {elapsed:?} to refuse a 50000×50000 header"
-    );
     assert!(!out.exists());
     // And the same through the helper (pre-existing output untouched).
     trace_must_fail(&p, &["size limit"]);
@@ -375,13 +385,12 @@ fn huge_declared_svg_canvas_is_capped_by_resolution() {
     )
     .unwrap();
     let out = t.path().join("out.svg");
-    let (o, elapsed) = flourish_timed(
+    let o = flourish_capped(
         t.path(),
         &["trace", s(&p), "-o", s(&out), "--resolution", "100000"],
-        Duration::from_secs(30),
+        1024,
     );
     assert_failure(&o, &p, &["size limit"]);
-    assert!(elapsed < Duration::from_secs(5), "took {elapsed:?}");
     assert!(!out.exists());
 }
 
@@ -402,7 +411,7 @@ fn svg_shapes_with_huge_coordinates_trace_quickly() {
 <rect x="20" y="20" width="10" height="10"/></svg>"#,
     );
     let out = t.path().join("out.svg");
-    let (o, _) = flourish_timed(
+    let o = flourish_guarded(
         t.path(),
         &["trace", s(&p), "-o", s(&out)],
         Duration::from_secs(120),
@@ -435,13 +444,12 @@ fn svg_long_stroked_path_traces_quickly() {
         ),
     );
     let out = t.path().join("out.svg");
-    let (o, took) = flourish_timed(
+    let o = flourish_guarded(
         t.path(),
         &["trace", s(&p), "-o", s(&out)],
-        Duration::from_secs(60),
+        Duration::from_secs(120),
     );
     assert!(o.status.success(), "stderr: {}", stderr(&o));
-    assert!(took < Duration::from_secs(20), "took {took:?}");
     assert!(std::fs::read_to_string(&out).unwrap().contains("<path"));
 }
 
@@ -474,7 +482,7 @@ fn endless_device_as_input_fails_at_the_size_limit() {
     let t = tempdir();
     let out = t.path().join("out.svg");
     for cmd in ["trace", "fill"] {
-        let (o, _) = flourish_timed(
+        let o = flourish_guarded(
             t.path(),
             &[cmd, s(dev), "-o", s(&out)],
             Duration::from_secs(30),
@@ -1226,7 +1234,7 @@ fn svg_external_references_are_not_followed() {
         let p = dir.join(name);
         std::fs::write(&p, body).unwrap();
         let out = dir.join(format!("{name}.out.svg"));
-        let (o, _) = flourish_timed(
+        let o = flourish_guarded(
             dir,
             &["trace", s(&p), "-o", s(&out)],
             Duration::from_secs(30),
@@ -1647,7 +1655,7 @@ fn brush_iterations_out_of_range_is_a_usage_error() {
 </svg>"##,
     );
     let out = t.path().join("out.svg");
-    let (o, _) = flourish_timed(
+    let o = flourish_guarded(
         t.path(),
         &[
             "brush",
@@ -1770,7 +1778,7 @@ fn brush_thin_diagonal_stroke_is_refused_at_the_canvas_limit() {
     );
     let out = t.path().join("out.svg");
     let cache = std::env::temp_dir().join("flourish-test-cache");
-    let (o, _) = flourish_timed(
+    let o = flourish_guarded(
         t.path(),
         &[
             "brush",
