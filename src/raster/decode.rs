@@ -98,6 +98,7 @@ impl RasterCoverage {
             height: h as f64,
             layers,
             warnings: Vec::new(),
+            notes: Vec::new(),
         }
     }
 }

@@ -68,6 +68,9 @@ pub struct Ink {
     pub layers: Vec<InkLayer>,
     /// What the input held that is not ink here, one line each.
     pub warnings: Vec<String>,
+    /// How the input was read, where it matters (for `--verbose`), one
+    /// line each.
+    pub notes: Vec<String>,
 }
 
 /// Reads `path` (raster or SVG, told apart by content) as ink.
@@ -484,6 +487,11 @@ impl FlatShape {
             FLATTEN_PX,
             &mut segments,
         );
+        FlatShape::from_segments(segments, shape.rule == tiny_skia::FillRule::EvenOdd)
+    }
+
+    /// The shape bounded by `segments` (closed loops, px), banded.
+    fn from_segments(segments: Vec<Line>, even_odd: bool) -> Self {
         let mut bbox = kurbo::Rect::new(f64::MAX, f64::MAX, f64::MIN, f64::MIN);
         for l in &segments {
             bbox = bbox.union_pt(l.p0).union_pt(l.p1);
@@ -491,7 +499,7 @@ impl FlatShape {
         let bands = Bands::new(&segments, bbox);
         FlatShape {
             segments,
-            even_odd: shape.rule == tiny_skia::FillRule::EvenOdd,
+            even_odd,
             bbox,
             bands,
         }
@@ -523,6 +531,26 @@ impl FlatShape {
         }
     }
 
+    /// How many segments [`FlatShape::winding`] reads at row `y`.
+    fn band_len(&self, y: f64) -> u64 {
+        match &self.bands {
+            Some(b) => b.bands[b.band(y)].len() as u64,
+            None => self.segments.len() as u64,
+        }
+    }
+
+    /// How many segments a winding number reads on average over the rows
+    /// (the mean band length; all segments when unbanded).
+    fn mean_band_len(&self) -> u64 {
+        match &self.bands {
+            Some(b) => {
+                let listed: usize = b.bands.iter().map(Vec::len).sum();
+                (listed / b.bands.len().max(1)) as u64 + 1
+            }
+            None => self.segments.len() as u64,
+        }
+    }
+
     fn contains(&self, p: Point) -> bool {
         if !self.bbox.contains(p) {
             return false;
@@ -541,7 +569,7 @@ const FLATTEN_PX: f64 = 0.01;
 
 /// Pixel centres inside the union of `shapes`, by exact scanline crossing
 /// counts with each shape's own fill rule.
-fn scan_inside(w: usize, h: usize, shapes: &[FlatShape]) -> Grid<bool> {
+fn scan_inside(w: usize, h: usize, shapes: &[&FlatShape]) -> Grid<bool> {
     let mut grid = Grid::new(w, h, false);
     for shape in shapes {
         super::scan::fill(
@@ -553,25 +581,32 @@ fn scan_inside(w: usize, h: usize, shapes: &[FlatShape]) -> Grid<bool> {
     grid
 }
 
+/// For each of `shapes`, the others whose boxes meet its box: the shapes
+/// that can bury its edges.
+fn overlapping(shapes: &[&FlatShape]) -> Vec<Vec<usize>> {
+    (0..shapes.len())
+        .map(|i| {
+            (0..shapes.len())
+                .filter(|&j| {
+                    let (a, b) = (shapes[i].bbox, shapes[j].bbox);
+                    j != i && a.intersect(b).area() >= 0.0 && overlaps(a, b)
+                })
+                .collect()
+        })
+        .collect()
+}
+
 /// The parts of the shapes' outlines that bound their union: a segment piece
 /// whose two sides are both inside (an edge of one shape buried in another,
-/// or in itself) or both outside is dropped.
-fn union_boundary(shapes: &[FlatShape]) -> Vec<Line> {
+/// or in itself) or both outside is dropped. `others` lists, per shape, the
+/// shapes that overlap it ([`overlapping`]).
+fn union_boundary(shapes: &[&FlatShape], others: &[Vec<usize>]) -> Vec<Line> {
     use rayon::prelude::*;
     shapes
         .par_iter()
-        .enumerate()
-        .flat_map_iter(|(i, shape)| {
-            let others: Vec<&FlatShape> = shapes
-                .iter()
-                .enumerate()
-                .filter(|(j, o)| {
-                    *j != i
-                        && o.bbox.intersect(shape.bbox).area() >= 0.0
-                        && overlaps(o.bbox, shape.bbox)
-                })
-                .map(|(_, o)| o)
-                .collect();
+        .zip(others)
+        .flat_map_iter(|(shape, others)| {
+            let others: Vec<&FlatShape> = others.iter().map(|&j| shapes[j]).collect();
             let lonely = others.is_empty();
             shape.segments.iter().filter_map(move |l| {
                 let d = l.p1 - l.p0;
@@ -593,6 +628,63 @@ fn union_boundary(shapes: &[FlatShape]) -> Vec<Line> {
             })
         })
         .collect()
+}
+
+/// One layer's flattened shapes, with the shapes overlapping each
+/// ([`overlapping`]).
+struct LayerShapes<'a> {
+    color: Color,
+    members: Vec<&'a FlatShape>,
+    others: Vec<Vec<usize>>,
+}
+
+/// Most segment reads the exact union boundary may take ([`ExactCost`]):
+/// about 2 s on one core. Past it, a drawing's outlines cross so densely
+/// (a scribble of thousands of strokes over the whole canvas, where every
+/// row meets every segment) that the winding numbers would take minutes.
+const MAX_WINDING_READS: u64 = 600_000_000;
+
+/// Most row crossings the exact scanline fill may hold (16 bytes each, so
+/// about 320 MB).
+const MAX_ROW_CROSSINGS: u64 = 20_000_000;
+
+/// What reading a layer's shapes exactly costs: the segments the union
+/// boundary's winding numbers read, and the row crossings of the scanline
+/// fill. Counted from the bands, before any of it is done.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct ExactCost {
+    winding_reads: u64,
+    row_crossings: u64,
+}
+
+impl ExactCost {
+    /// The cost of [`scan_inside`] and [`union_boundary`] on `shapes`
+    /// (with their `others`) on a canvas `h` px tall.
+    fn of(shapes: &[&FlatShape], others: &[Vec<usize>], h: usize) -> ExactCost {
+        let mut cost = ExactCost::default();
+        let means: Vec<u64> = shapes.iter().map(|s| s.mean_band_len()).collect();
+        for (shape, others) in shapes.iter().zip(others) {
+            let rest: u64 = others.iter().map(|&j| means[j]).sum();
+            for l in &shape.segments {
+                let (lo, hi) = (l.p0.y.min(l.p1.y), l.p0.y.max(l.p1.y));
+                if lo < hi {
+                    let r0 = (lo - 0.5).ceil().clamp(0.0, h as f64);
+                    let r1 = (hi - 0.5).ceil().clamp(0.0, h as f64);
+                    cost.row_crossings += (r1 - r0) as u64;
+                }
+                // Two probes per segment, each reading its band of this
+                // shape and of every overlapping one.
+                let m = l.p0.midpoint(l.p1);
+                let own = shape.band_len(m.y);
+                cost.winding_reads = cost.winding_reads.saturating_add(2 * (own + rest));
+            }
+        }
+        cost
+    }
+
+    fn affordable(self) -> bool {
+        self.winding_reads <= MAX_WINDING_READS && self.row_crossings <= MAX_ROW_CROSSINGS
+    }
 }
 
 fn overlaps(a: kurbo::Rect, b: kurbo::Rect) -> bool {
@@ -644,13 +736,16 @@ pub fn svg_ink(
             colours.push(s.color);
         }
     }
-    let layer_sets: Vec<(Color, Vec<&SvgShape>)> = if opts.layers && !opts.invert {
+    // Each layer's shapes, as indices into `shapes`.
+    let layer_sets: Vec<(Color, Vec<usize>)> = if opts.layers && !opts.invert {
         (0..colours.len())
             .map(|k| {
                 let above = &colours[k..];
                 (
                     colours[k],
-                    shapes.iter().filter(|s| above.contains(&s.color)).collect(),
+                    (0..shapes.len())
+                        .filter(|&i| above.contains(&shapes[i].color))
+                        .collect(),
                 )
             })
             .collect()
@@ -662,16 +757,52 @@ pub fn svg_ink(
         } else {
             Color::BLACK
         };
-        vec![(colour, shapes.iter().collect())]
+        vec![(colour, (0..shapes.len()).collect())]
     };
+    // Each shape flattened once, then grouped by layer.
+    let flat: Vec<FlatShape> = shapes.iter().map(|s| FlatShape::new(s, pw, ph)).collect();
+    let sets: Vec<LayerShapes> = layer_sets
+        .into_iter()
+        .map(|(color, set)| {
+            let members: Vec<&FlatShape> = set.iter().map(|&k| &flat[k]).collect();
+            let others = overlapping(&members);
+            LayerShapes {
+                color,
+                members,
+                others,
+            }
+        })
+        .collect();
+    let cost = sets.iter().fold(ExactCost::default(), |acc, set| {
+        let c = ExactCost::of(&set.members, &set.others, ph);
+        ExactCost {
+            winding_reads: acc.winding_reads.saturating_add(c.winding_reads),
+            row_crossings: acc.row_crossings.saturating_add(c.row_crossings),
+        }
+    });
+    if !cost.affordable() {
+        // Too dense to measure exactly: read the drawing's render, as a
+        // raster's anti-aliased coverage is read.
+        let mut ink = rendered_ink(path, tree, opts, skip_id, (pw, ph), canvas, to_user)?;
+        ink.notes.push(format!(
+            "outlines too dense for exact distances ({} segments cross {} rows of pixels); read from the anti-aliased render",
+            flat.iter().map(|f| f.segments.len()).sum::<usize>(),
+            cost.row_crossings
+        ));
+        return Ok(ink);
+    }
     let mut layers = Vec::new();
-    for (color, set) in layer_sets {
-        let flat: Vec<FlatShape> = set.iter().map(|s| FlatShape::new(s, pw, ph)).collect();
-        let mut inside = scan_inside(pw, ph, &flat);
+    for LayerShapes {
+        color,
+        members,
+        others,
+    } in sets
+    {
+        let mut inside = scan_inside(pw, ph, &members);
         if opts.invert {
             inside = inside.map(|i| !i);
         }
-        let segments = union_boundary(&flat);
+        let segments = union_boundary(&members, &others);
         layers.push(InkLayer {
             color,
             sdf: Sdf::from_segments(&inside, &segments, to_user),
@@ -682,5 +813,90 @@ pub fn svg_ink(
         height: uh,
         layers,
         warnings: Vec::new(),
+        notes: Vec::new(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn polygon(pts: &[(f64, f64)]) -> Vec<Line> {
+        (0..pts.len())
+            .map(|i| {
+                let (a, b) = (pts[i], pts[(i + 1) % pts.len()]);
+                Line::new(a, b)
+            })
+            .collect()
+    }
+
+    fn cost(shapes: &[FlatShape], h: usize) -> ExactCost {
+        let refs: Vec<&FlatShape> = shapes.iter().collect();
+        ExactCost::of(&refs, &overlapping(&refs), h)
+    }
+
+    #[test]
+    fn exact_cost_of_a_square_counts_its_probes_and_rows() {
+        let sq = polygon(&[(2.25, 2.25), (12.25, 2.25), (12.25, 12.25), (2.25, 12.25)]);
+        let c = cost(&[FlatShape::from_segments(sq, false)], 20);
+        // Unbanded: 4 segments, two probes each, each reading all 4.
+        assert_eq!(c.winding_reads, 32);
+        // Each side edge crosses the rows with centres 2.5 ..= 11.5.
+        assert_eq!(c.row_crossings, 20);
+        // Rows off the canvas are not crossed.
+        assert_eq!(
+            cost(
+                &[FlatShape::from_segments(
+                    polygon(&[(2.25, 2.25), (12.25, 2.25), (12.25, 12.25), (2.25, 12.25)]),
+                    false
+                )],
+                5
+            )
+            .row_crossings,
+            6
+        );
+    }
+
+    #[test]
+    fn exact_cost_grows_with_the_square_of_segments_crossing_the_same_rows() {
+        // A zigzag whose every segment spans the whole height: banding
+        // cannot help, each probe reads every segment.
+        let zigzag = |n: usize| {
+            let mut pts: Vec<(f64, f64)> = (0..n)
+                .map(|i| (i as f64, if i % 2 == 0 { 0.0 } else { 100.0 }))
+                .collect();
+            pts.push((n as f64, 200.0));
+            FlatShape::from_segments(polygon(&pts), false)
+        };
+        let (small, large) = (cost(&[zigzag(200)], 200), cost(&[zigzag(400)], 200));
+        assert_eq!(small.winding_reads, 2 * 201 * 201);
+        assert_eq!(large.winding_reads, 2 * 401 * 401);
+        assert!(small.affordable());
+        let huge = cost(&[zigzag(20_000)], 200);
+        assert!(!huge.affordable(), "{huge:?}");
+        // A tall shape of many short segments is banded: far fewer reads.
+        let circle: Vec<(f64, f64)> = (0..20_000)
+            .map(|i| {
+                let a = i as f64 / 20_000.0 * std::f64::consts::TAU;
+                (500.0 + 400.0 * a.cos(), 500.0 + 400.0 * a.sin())
+            })
+            .collect();
+        let round = cost(&[FlatShape::from_segments(polygon(&circle), false)], 1000);
+        assert!(round.winding_reads < 2 * 20_000 * 100, "{round:?}");
+        assert!(round.affordable());
+    }
+
+    #[test]
+    fn exact_cost_counts_the_overlapping_shapes_each_probe_reads() {
+        let sq = |x: f64| {
+            FlatShape::from_segments(
+                polygon(&[(x, 0.0), (x + 10.0, 0.0), (x + 10.0, 10.0), (x, 10.0)]),
+                false,
+            )
+        };
+        // Apart: each probe reads its own 4 segments.
+        assert_eq!(cost(&[sq(0.0), sq(20.0)], 10).winding_reads, 2 * 32);
+        // Overlapping: each probe also reads the other's 4.
+        assert_eq!(cost(&[sq(0.0), sq(5.0)], 10).winding_reads, 2 * 64);
+    }
 }

@@ -319,6 +319,7 @@ pub fn trace_ink(ink: &Ink, opts: &TraceOptions) -> Result<Document> {
             .extend(layer_group(i, trace_sdf(&layer.sdf, opts), layer.color));
     }
     doc.warnings = ink.warnings.clone();
+    doc.notes = ink.notes.clone();
     Ok(doc)
 }
 
