@@ -63,17 +63,31 @@ pub fn border_rings(r: &QueryResult) -> usize {
 pub fn extend_field(style: &BrushStyle, field: &Field, rings: usize) -> Field {
     let mut f = field.clone();
     let (w, h) = (f.coords.width(), f.coords.height());
+    // Only pixels next to the covered region can be reached: each ring
+    // scans the covered pixels' box grown by one pixel (a tiny stroke's
+    // ornament covers a small part of its canvas).
+    let Some(mut bx) = covered_box(&f.coords) else {
+        return f;
+    };
     for _ in 0..rings {
-        let snap = f.clone();
-        let rows: Vec<Vec<(usize, Coord, [f32; 2])>> = (0..h)
+        bx = [
+            bx[0].saturating_sub(1),
+            bx[1].saturating_sub(1),
+            (bx[2] + 1).min(w - 1),
+            (bx[3] + 1).min(h - 1),
+        ];
+        // Every pixel of a ring reads the field as it was before the ring
+        // (the updates are gathered first, then written).
+        let snap = &f;
+        let rows: Vec<(usize, Vec<Continued>)> = (bx[1]..=bx[3])
             .into_par_iter()
             .map(|y| {
                 let mut out = Vec::new();
-                for x in 0..w {
+                for x in bx[0]..=bx[2] {
                     if snap.coords.get(x, y).is_some() {
                         continue;
                     }
-                    let mut best: Option<(usize, Coord, [f32; 2])> = None;
+                    let mut best: Option<Continued> = None;
                     let mut counts: Vec<(u32, usize)> = Vec::new();
                     let mut preds: Vec<(u32, Coord, [f32; 2])> = Vec::new();
                     for (dx, dy) in NEIGHBOURS {
@@ -82,7 +96,7 @@ pub fn extend_field(style: &BrushStyle, field: &Field, rings: usize) -> Field {
                             continue;
                         };
                         let (nx, ny) = (nx as usize, ny as usize);
-                        let Some(j) = synth::jacobian(style, &snap, nx, ny) else {
+                        let Some(j) = synth::jacobian(style, snap, nx, ny) else {
                             continue;
                         };
                         let d = synth::apply(j, [-dx as f32, -dy as f32]);
@@ -105,11 +119,11 @@ pub fn extend_field(style: &BrushStyle, field: &Field, rings: usize) -> Field {
                     }
                     out.extend(best);
                 }
-                out
+                (y, out)
             })
             .collect();
         let mut any = false;
-        for (y, row) in rows.into_iter().enumerate() {
+        for (y, row) in rows {
             for (x, c, o) in row {
                 f.coords.set(x, y, Some(c));
                 f.orient.set(x, y, o);
@@ -121,6 +135,28 @@ pub fn extend_field(style: &BrushStyle, field: &Field, rings: usize) -> Field {
         }
     }
     f
+}
+
+/// A pixel the continuation reaches: its column, coordinate and
+/// orientation.
+type Continued = (usize, Coord, [f32; 2]);
+
+/// The box `[x0, y0, x1, y1]` (inclusive) of the covered pixels of a
+/// coordinate grid, `None` when none is covered.
+fn covered_box(coords: &Grid<Option<Coord>>) -> Option<[usize; 4]> {
+    let w = coords.width();
+    let mut bx: Option<[usize; 4]> = None;
+    for (i, c) in coords.data().iter().enumerate() {
+        if c.is_none() {
+            continue;
+        }
+        let (x, y) = (i % w, i / w);
+        bx = Some(match bx {
+            None => [x, y, x, y],
+            Some(b) => [b[0].min(x), b[1].min(y), b[2].max(x), b[3].max(y)],
+        });
+    }
+    bx
 }
 
 /// Radius of the blended read, px.
@@ -159,6 +195,26 @@ pub fn layer_sdf(style: &BrushStyle, r: &QueryResult, color: Option<Color>) -> G
 
 /// [`layer_sdf`] of a given (already extended) field.
 pub fn blended_sdf(style: &BrushStyle, field: &Field, color: Option<Color>) -> Grid<f32> {
+    blended_sdf_with(style, field, &jacobians(style, field), color)
+}
+
+/// The Jacobian of every pixel of a field ([`synth::jacobian`]), row-major.
+fn jacobians(style: &BrushStyle, field: &Field) -> Vec<Option<synth::Jacobian>> {
+    let (w, h) = (field.coords.width(), field.coords.height());
+    (0..h)
+        .into_par_iter()
+        .flat_map_iter(|y| (0..w).map(move |x| synth::jacobian(style, field, x, y)))
+        .collect()
+}
+
+/// [`blended_sdf`] with the field's Jacobians already measured (`jac`,
+/// from [`jacobians`]): the layers of one query share them.
+fn blended_sdf_with(
+    style: &BrushStyle,
+    field: &Field,
+    jac: &[Option<synth::Jacobian>],
+    color: Option<Color>,
+) -> Grid<f32> {
     let g = &field.coords;
     let (w, h) = (g.width(), g.height());
     let level = field.level;
@@ -179,11 +235,6 @@ pub fn blended_sdf(style: &BrushStyle, field: &Field, color: Option<Color>) -> G
             .map(|grid| grid.sample(c.x as f64, c.y as f64))
             .unwrap_or(PAPER)
     };
-    // Jacobians once per pixel.
-    let jac: Vec<Option<synth::Jacobian>> = (0..h)
-        .into_par_iter()
-        .flat_map_iter(|y| (0..w).map(move |x| synth::jacobian(style, field, x, y)))
-        .collect();
     let rows: Vec<Vec<f32>> = (0..h)
         .into_par_iter()
         .map(|y| {
@@ -310,11 +361,44 @@ pub fn smallest_exemplar_component(style: &BrushStyle) -> usize {
 /// not a constant) are synthesis debris and are cleared; the query's
 /// largest piece is its body and always stays.
 pub fn final_layers(style: &BrushStyle, r: &QueryResult) -> Vec<(Color, Grid<f32>)> {
+    final_layers_with(style, r, &StyleFacts::of(style))
+}
+
+/// What the output stage needs to know about a style, measured once per
+/// sketch instead of once per query (the smallest drawn element scans
+/// every exemplar's finest ink: 45 M instructions, a fifth of a tiny
+/// stroke's whole cost).
+#[derive(Clone, Debug)]
+struct StyleFacts {
+    /// The layer colours ([`palette`]).
+    palette: Vec<Color>,
+    /// [`smallest_exemplar_component`].
+    smallest_piece: usize,
+}
+
+impl StyleFacts {
+    fn of(style: &BrushStyle) -> StyleFacts {
+        StyleFacts {
+            palette: palette(style),
+            smallest_piece: smallest_exemplar_component(style),
+        }
+    }
+}
+
+/// [`final_layers`] with the style's facts already measured.
+fn final_layers_with(
+    style: &BrushStyle,
+    r: &QueryResult,
+    facts: &StyleFacts,
+) -> Vec<(Color, Grid<f32>)> {
     let field = extend_field(style, &r.field, border_rings(r));
-    let mut layers: Vec<(Color, Grid<f32>)> = palette(style)
-        .into_iter()
-        .map(|c| (c, blended_sdf(style, &field, Some(c))))
+    let jac = jacobians(style, &field);
+    let mut layers: Vec<(Color, Grid<f32>)> = facts
+        .palette
+        .iter()
+        .map(|&c| (c, blended_sdf_with(style, &field, &jac, Some(c))))
         .collect();
+    drop(jac);
     let Some((_, first)) = layers.first() else {
         return layers;
     };
@@ -324,7 +408,7 @@ pub fn final_layers(style: &BrushStyle, r: &QueryResult) -> Vec<(Color, Grid<f32
     // A query shorter than every exemplar can have a body smaller than
     // the exemplars' smallest piece: the largest piece always stays.
     let largest = comps.iter().map(Vec::len).max().unwrap_or(0);
-    let min = smallest_exemplar_component(style).min(largest);
+    let min = facts.smallest_piece.min(largest);
     for comp in comps {
         if comp.len() >= min {
             continue;
@@ -343,9 +427,20 @@ pub fn final_layers(style: &BrushStyle, r: &QueryResult) -> Vec<(Color, Grid<f32
 /// Traces a synthesized query into one group of filled shapes, bottom
 /// layer first.
 pub fn trace_query(style: &BrushStyle, r: &QueryResult, id: String, opts: &TraceOptions) -> Group {
+    trace_query_with(style, r, id, opts, &StyleFacts::of(style))
+}
+
+/// [`trace_query`] with the style's facts already measured.
+fn trace_query_with(
+    style: &BrushStyle,
+    r: &QueryResult,
+    id: String,
+    opts: &TraceOptions,
+    facts: &StyleFacts,
+) -> Group {
     let to_user = r.canvas.to_user();
     let mut shapes = Vec::new();
-    for (color, dist) in final_layers(style, r) {
+    for (color, dist) in final_layers_with(style, r, facts) {
         let sdf = Sdf { dist, to_user };
         for p in trace_sdf(&sdf, opts) {
             shapes.push(Shape {
@@ -474,6 +569,7 @@ pub fn brush_sketch(
         None => None,
     };
     let trace = TraceOptions::default();
+    let facts = StyleFacts::of(style);
     let done: Vec<(QueryResult, Group)> = spines
         .par_iter()
         .map(|q| {
@@ -504,7 +600,7 @@ pub fn brush_sketch(
             } else {
                 r.spine.query_id.clone()
             };
-            let group = trace_query(style, &r, id, &trace);
+            let group = trace_query_with(style, &r, id, &trace, &facts);
             if opts.discard_fields {
                 r.field = Field {
                     level: r.field.level,

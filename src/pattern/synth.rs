@@ -18,7 +18,9 @@
 //!    §5.2), the one with the smallest σ-normalized error is taken.
 //!
 //! Because target elements are copies of reference elements, every pair
-//! measure is a lookup in a table of reference × reference measures.
+//! measure is a lookup in a table of reference × reference measures (for
+//! an example of more than [`MAX_TABLED_ELEMENTS`] elements, computed when
+//! needed instead: the same values without the n² memory).
 //!
 //! The variation post-process (§3.3), scaled by t ∈ [0, 1]: with
 //! probability t an element's length/width/colour are exchanged with a
@@ -149,25 +151,49 @@ pub struct Reference {
     pub dist: Distribution,
     /// For each element, its k-ring as (element, offset from its centre).
     pub hoods: Vec<Vec<(usize, Vec2)>>,
-    /// measures[a·n + b] between elements a and b.
+    /// measures[a·n + b] between elements a and b, when there are at most
+    /// [`MAX_TABLED_ELEMENTS`] elements; empty otherwise, and the measures
+    /// are computed when asked for (the same values).
     pub table: Vec<Measures>,
     /// The thresholds in use.
     pub thresholds: Thresholds,
     /// Rings per neighbourhood.
     pub rings: usize,
+    /// The floor guarding the length ratio of point-like elements.
+    pub floor: f64,
 }
 
+/// Largest number of reference elements whose pair measures are
+/// precomputed: the table holds n² entries of 40 bytes (42 MB at this
+/// limit; an example of 10 000 separate strokes would need 4 GB).
+pub const MAX_TABLED_ELEMENTS: usize = 1024;
+
 impl Reference {
-    /// Precomputes neighbourhoods and the measure table.
+    /// Precomputes neighbourhoods and, for at most
+    /// [`MAX_TABLED_ELEMENTS`] elements, the measure table.
     pub fn new(elements: Vec<Element>, dist: Distribution, rings: usize) -> Reference {
+        Reference::with_table_limit(elements, dist, rings, MAX_TABLED_ELEMENTS)
+    }
+
+    /// [`Reference::new`] with the measure table built only for at most
+    /// `table_limit` elements.
+    fn with_table_limit(
+        elements: Vec<Element>,
+        dist: Distribution,
+        rings: usize,
+        table_limit: usize,
+    ) -> Reference {
         let n = elements.len();
         let mean_len = elements.iter().map(|e| e.length()).sum::<f64>() / n.max(1) as f64;
         let thresholds = Thresholds::paper(mean_len);
         let floor = (mean_len * 1e-3).max(1e-9);
-        let mut table = Vec::with_capacity(n * n);
-        for a in &elements {
-            for b in &elements {
-                table.push(Measures::between(a, b, floor));
+        let mut table = Vec::new();
+        if n <= table_limit {
+            table.reserve_exact(n * n);
+            for a in &elements {
+                for b in &elements {
+                    table.push(Measures::between(a, b, floor));
+                }
             }
         }
         let hoods = (0..n)
@@ -186,12 +212,17 @@ impl Reference {
             table,
             thresholds,
             rings,
+            floor,
         }
     }
 
-    /// The measures between reference elements a and b.
-    pub fn m(&self, a: usize, b: usize) -> &Measures {
-        &self.table[a * self.elements.len() + b]
+    /// The measures between reference elements a and b (from the table
+    /// when there is one).
+    pub fn m(&self, a: usize, b: usize) -> Measures {
+        match self.table.get(a * self.elements.len() + b) {
+            Some(m) => *m,
+            None => Measures::between(&self.elements[a], &self.elements[b], self.floor),
+        }
     }
 
     /// Averaged measures between the reference neighbourhood of `cand` and
@@ -218,7 +249,7 @@ impl Reference {
             if back != ri {
                 continue;
             }
-            sum.add(self.m(r_el, known[ti].0));
+            sum.add(&self.m(r_el, known[ti].0));
             pairs += 1;
         }
         (pairs > 0).then(|| {
@@ -504,5 +535,79 @@ mod tests {
         assert!(r.compare(0, &known).is_none());
         // A neighbour far off the reference positions is not paired.
         assert!(r.compare(3, &[(2, Vec2::new(-10.0, 30.0))]).is_none());
+    }
+
+    fn field(n: usize) -> Vec<Element> {
+        // A jittered grid of bars of a few lengths, angles and colours.
+        let side = (n as f64).sqrt().ceil() as usize;
+        (0..n)
+            .map(|i| {
+                let (x, y) = ((i % side) as f64, (i / side) as f64);
+                let h = rng::unit(&[7, i as u64]);
+                let mut e = bar(
+                    10.0 * x + 3.0 * h,
+                    (i % 5) as f64 * 0.3,
+                    4.0 + (i % 3) as f64,
+                    [(i % 2) as f64 * 0.5, 0.0, 0.0],
+                );
+                e.centre.y = 10.0 * y + 2.0 * rng::unit(&[8, i as u64]);
+                e
+            })
+            .collect()
+    }
+
+    fn reference(n: usize, table_limit: usize) -> Reference {
+        let els = field(n);
+        let heights = vec![5.0; n];
+        let dist = Distribution::analyse(
+            els.iter().map(|e| e.centre).collect(),
+            &heights,
+            Dim::Two,
+            10.0,
+        );
+        Reference::with_table_limit(els, dist, 2, table_limit)
+    }
+
+    #[test]
+    fn measures_computed_on_demand_equal_the_table() {
+        let (tabled, untabled) = (reference(60, usize::MAX), reference(60, 0));
+        assert_eq!(tabled.table.len(), 60 * 60);
+        assert!(untabled.table.is_empty());
+        for a in 0..60 {
+            for b in 0..60 {
+                assert_eq!(tabled.m(a, b), untabled.m(a, b));
+            }
+        }
+        // The same synthesis and variation, bit for bit.
+        let pos: Vec<Point> = (0..150)
+            .map(|i| Point::new((i % 15) as f64 * 9.5, (i / 15) as f64 * 9.0))
+            .collect();
+        let target = Target {
+            graph: Graph::delaunay(&pos),
+            pos,
+            period: None,
+            dim: Dim::Two,
+        };
+        let a = synthesize(&tabled, &target, &[3]);
+        assert_eq!(a, synthesize(&untabled, &target, &[3]));
+        let keep = |_: Point| true;
+        assert_eq!(
+            vary(&tabled, &target, &a, 0.7, &[3], &keep),
+            vary(&untabled, &target, &a, 0.7, &[3], &keep)
+        );
+    }
+
+    #[test]
+    fn a_large_example_keeps_no_quadratic_table() {
+        let n = MAX_TABLED_ELEMENTS + 1;
+        let r = reference(n, MAX_TABLED_ELEMENTS);
+        assert_eq!(r.table.capacity(), 0);
+        assert_eq!(
+            r.m(0, n - 1),
+            Measures::between(&r.elements[0], &r.elements[n - 1], r.floor)
+        );
+        // At the limit the table is exact-sized, n² entries.
+        let r = reference(64, 64);
+        assert_eq!(r.table.len(), 64 * 64);
     }
 }

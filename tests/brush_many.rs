@@ -1,0 +1,160 @@
+//! `flourish brush` on sketches of many small strokes: the output stage
+//! measures the style once per sketch and continues each query's field only
+//! around its ornament, and both give what the per-query, whole-canvas
+//! reading gives.
+
+use flourish::brush::output::{brush_sketch, extend_field, trace_query};
+use flourish::brush::pipeline::BrushOptions;
+use flourish::brush::synth::{self, Coord, Field};
+use flourish::raster::Grid;
+use flourish::style::brush::{AnalysisOptions, BrushStyle};
+use flourish::trace::TraceOptions;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn vine() -> &'static BrushStyle {
+    static STYLE: OnceLock<BrushStyle> = OnceLock::new();
+    STYLE.get_or_init(|| {
+        let opts = AnalysisOptions {
+            cache_dir: Some(std::env::temp_dir().join("flourish-test-cache")),
+            ..AnalysisOptions::default()
+        };
+        BrushStyle::load(&root().join("styles/vine"), &opts).expect("style loads")
+    })
+}
+
+/// The 8-neighbour offsets in scan order (as the output stage reads them).
+const NEIGHBOURS: [(isize, isize); 8] = [
+    (-1, -1),
+    (0, -1),
+    (1, -1),
+    (-1, 0),
+    (1, 0),
+    (-1, 1),
+    (0, 1),
+    (1, 1),
+];
+
+/// The documented continuation, ring by ring over the whole canvas from a
+/// copy of the field: the oracle for [`extend_field`].
+fn extend_naive(style: &BrushStyle, field: &Field, rings: usize) -> Field {
+    let mut f = field.clone();
+    let (w, h) = (f.coords.width(), f.coords.height());
+    for _ in 0..rings {
+        let snap = f.clone();
+        let mut any = false;
+        for y in 0..h {
+            for x in 0..w {
+                if snap.coords.get(x, y).is_some() {
+                    continue;
+                }
+                let mut counts: Vec<(u32, usize)> = Vec::new();
+                let mut preds: Vec<(u32, Coord, [f32; 2])> = Vec::new();
+                for (dx, dy) in NEIGHBOURS {
+                    let (nx, ny) = (x as isize + dx, y as isize + dy);
+                    let Some(c) = snap.coords.get_or(nx, ny, None) else {
+                        continue;
+                    };
+                    let (nx, ny) = (nx as usize, ny as usize);
+                    let Some(j) = synth::jacobian(style, &snap, nx, ny) else {
+                        continue;
+                    };
+                    let d = synth::apply(j, [-dx as f32, -dy as f32]);
+                    let p = Coord {
+                        exemplar: c.exemplar,
+                        x: c.x + d[0],
+                        y: c.y + d[1],
+                    };
+                    match counts.iter_mut().find(|(e, _)| *e == c.exemplar) {
+                        Some(k) => k.1 += 1,
+                        None => counts.push((c.exemplar, 1)),
+                    }
+                    preds.push((c.exemplar, p, snap.orient.get(nx, ny)));
+                }
+                let top = counts.iter().map(|c| c.1).max().unwrap_or(0);
+                if let Some((e, _)) = counts.iter().find(|c| c.1 == top) {
+                    if let Some((_, p, o)) = preds.iter().find(|p| p.0 == *e) {
+                        f.coords.set(x, y, Some(*p));
+                        f.orient.set(x, y, *o);
+                        any = true;
+                    }
+                }
+            }
+        }
+        if !any {
+            break;
+        }
+    }
+    f
+}
+
+#[test]
+fn a_field_is_continued_as_a_whole_canvas_scan_continues_it() {
+    let style = vine();
+    // A blob of two exemplars' coordinates touching the canvas's left and
+    // top edges, with a hole, on a canvas larger than it.
+    let (w, h) = (40, 30);
+    let coords = Grid::from_fn(w, h, |x, y| {
+        let (dx, dy) = (x as f32 - 6.0, y as f32 - 5.0);
+        let r2 = dx * dx + 0.6 * dy * dy;
+        (r2 < 90.0 && r2 > 4.0).then(|| Coord {
+            exemplar: u32::from(x > 8),
+            x: 120.0 + 0.9 * x as f32 + 0.2 * y as f32,
+            y: 240.0 + 1.1 * y as f32,
+        })
+    });
+    let field = Field {
+        level: 2,
+        orient: Grid::from_fn(
+            w,
+            h,
+            |x, _| if x % 3 == 0 { [0.6, 0.8] } else { [1.0, 0.0] },
+        ),
+        seam: Grid::new(w, h, false),
+        coords,
+    };
+    for rings in [1, 4, 12] {
+        assert_eq!(
+            extend_field(style, &field, rings),
+            extend_naive(style, &field, rings),
+            "{rings} rings"
+        );
+    }
+    // Nothing covered: nothing to continue.
+    let empty = Field {
+        coords: Grid::new(w, h, None),
+        ..field
+    };
+    assert_eq!(extend_field(style, &empty, 4), empty);
+}
+
+#[test]
+fn many_small_strokes_each_trace_as_alone() {
+    let style = vine();
+    let mut body = String::new();
+    for i in 0..6 {
+        let (x, y) = (15.0 + 23.0 * i as f64, 20.0 + 9.0 * (i % 3) as f64);
+        body.push_str(&format!(
+            r#"<path d="M{x} {y} l {} 3" fill="none" stroke="black" stroke-width="2"/>"#,
+            1 + i
+        ));
+    }
+    let svg = format!(
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="160" height="60" viewBox="0 0 160 60">{body}</svg>"#
+    );
+    let sk = flourish::sketch::parse(Path::new("many.svg"), svg.as_bytes()).expect("parses");
+    let out = brush_sketch(style, &sk, &BrushOptions::default()).expect("brushes");
+    assert_eq!(out.queries.len(), 6);
+    assert_eq!(out.document.groups.len(), 6);
+    for (r, g) in out.queries.iter().zip(&out.document.groups) {
+        assert!(!g.shapes.is_empty(), "{}: no ink", g.id);
+        // The style measured once for the sketch gives what measuring it
+        // for this query alone gives.
+        let alone = trace_query(style, r, g.id.clone(), &TraceOptions::default());
+        assert_eq!(&alone, g, "{}", g.id);
+    }
+}
