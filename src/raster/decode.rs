@@ -329,6 +329,33 @@ struct InkScale {
     /// above the paper, the darkest level with no more than
     /// [`INK_OUTLIERS`] of them darker still.
     ink: f32,
+    /// Raw coverage up to which the paper's own grain reaches: the darkest
+    /// level of the paper's peak ([`grain_top`]); the paper itself on a
+    /// clean picture.
+    grain: f32,
+}
+
+/// Share of the paper's most common level's count down to which the
+/// levels next to it still belong to the paper's peak (about 2.8 σ of
+/// Gaussian grain; an anti-aliased edge's levels hold a small fraction of
+/// the paper's).
+const GRAIN_PEAK_SHARE: f64 = 0.02;
+
+/// The bins `lo..=hi` of the paper's peak round its most common bin
+/// `paper`: walking lighter and darker from it, the unbroken runs whose
+/// counts stay at or above [`GRAIN_PEAK_SHARE`] of the paper's count
+/// (bins are lightest first, so darker is higher). One bin on clean paper.
+fn paper_peak(counts: &[u64; 256], paper: usize) -> (usize, usize) {
+    let least = counts[paper] as f64 * GRAIN_PEAK_SHARE;
+    let in_peak = |b: usize| counts[b] > 0 && counts[b] as f64 >= least;
+    let (mut lo, mut hi) = (paper, paper);
+    while lo > 0 && in_peak(lo - 1) {
+        lo -= 1;
+    }
+    while hi + 1 < 256 && in_peak(hi + 1) {
+        hi += 1;
+    }
+    (lo, hi)
 }
 
 impl InkScale {
@@ -336,6 +363,7 @@ impl InkScale {
     const RAW: InkScale = InkScale {
         paper: 0.0,
         ink: 1.0,
+        grain: 0.0,
     };
 
     /// The scale of a histogram of raw coverage in 256 bins, lightest
@@ -344,11 +372,29 @@ impl InkScale {
     /// pixel stands out from the paper.
     fn from_histogram(counts: &[u64; 256], value: impl Fn(usize) -> f32) -> InkScale {
         let held = |b: &usize| counts[*b] > 0;
-        let paper = (0..256)
+        let paper_bin = (0..256)
             .filter(held)
             .filter(|&b| value(b) < PAPER_NOISE)
-            .max_by_key(|&b| (counts[b], std::cmp::Reverse(b)))
-            .map_or(0.0, &value);
+            .max_by_key(|&b| (counts[b], std::cmp::Reverse(b)));
+        // Grainy paper is a peak of levels: the paper is its mean, and the
+        // grain reaches its darkest level. On clean paper, one level.
+        let (paper, grain) = match paper_bin {
+            None => (0.0, 0.0),
+            Some(b) => {
+                let (lo, hi) = paper_peak(counts, b);
+                if lo == hi {
+                    (value(b), value(b))
+                } else {
+                    let (sum, n) = (lo..=hi).fold((0.0, 0u64), |(s, n), k| {
+                        (s + f64::from(value(k)) * counts[k] as f64, n + counts[k])
+                    });
+                    ((sum / n.max(1) as f64) as f32, value(hi))
+                }
+            }
+        };
+        // The ink's darkest level is as far past the ink as the grain
+        // reaches past the paper.
+        let spread = grain - paper;
         let inked: Vec<usize> = (0..256)
             .filter(held)
             .filter(|&b| value(b) >= paper + PAPER_NOISE)
@@ -361,7 +407,8 @@ impl InkScale {
             if darker > allowed {
                 return InkScale {
                     paper,
-                    ink: value(b),
+                    ink: (value(b) - spread).max(paper + PAPER_NOISE),
+                    grain: grain.min(paper + PAPER_NOISE),
                 };
             }
         }
@@ -399,6 +446,14 @@ impl InkScale {
     fn coverage(&self, c: f32) -> f32 {
         if *self == InkScale::RAW {
             return c;
+        }
+        // The paper's grain is paper: a pixel within it reads 0. Grain
+        // left on the paper round a hairline would join its faint edge
+        // pixels into long runs of "ink" and hide that the line is thin
+        // (`sdf::ThinRuns`), and the line would break where its pixels
+        // are under one half.
+        if c <= self.grain {
+            return 0.0;
         }
         ((c - self.paper) / (self.ink - self.paper)).clamp(0.0, 1.0)
     }
@@ -827,6 +882,43 @@ mod tests {
         // Nothing above the paper noise.
         let blank = InkScale::from_histogram(&hist(&[(0, 9000), (12, 30)]), value);
         assert_eq!(blank, InkScale::RAW);
+    }
+
+    /// Grainy paper is a peak of levels: the paper is read at the peak's
+    /// mean, the ink as far inside its darkest level as the grain reaches
+    /// past the paper, and every level of the grain as paper; an
+    /// anti-aliased edge's few pixels next to clean paper are not grain.
+    #[test]
+    fn grainy_paper_is_measured_as_a_peak() {
+        let value = |b: usize| b as f32 / 255.0;
+        let mut h = [0u64; 256];
+        // Paper at 20 ± 4 (flat grain), ink at 200 ± 4, a few edge pixels.
+        h[16..=24].fill(1000);
+        h[196..=204].fill(300);
+        for b in (40..180).step_by(10) {
+            h[b] = 5;
+        }
+        let s = InkScale::from_histogram(&h, value);
+        assert!((s.paper - value(20)).abs() < 1e-6, "{s:?}");
+        assert!((s.grain - value(24)).abs() < 1e-6, "{s:?}");
+        assert!((s.ink - value(200)).abs() < 1e-6, "{s:?}");
+        assert_eq!(s.coverage(value(24)), 0.0);
+        assert_eq!(s.coverage(value(16)), 0.0);
+        assert!(s.coverage(value(25)) > 0.0);
+        assert!((s.coverage(value(110)) - 0.5).abs() < 1e-6);
+        assert_eq!(s.coverage(value(204)), 1.0);
+        // One level of paper (a clean scan): its neighbours' edge pixels
+        // are not grain, and nothing changes.
+        let mut clean = [0u64; 256];
+        clean[20] = 9000;
+        clean[21] = 40;
+        clean[200] = 3000;
+        let c = InkScale::from_histogram(&clean, value);
+        assert_eq!(
+            (c.paper, c.grain, c.ink),
+            (value(20), value(20), value(200))
+        );
+        assert!(c.coverage(value(21)) > 0.0);
     }
 
     /// A drawing in one light ink traces as a drawing, in its colour; two
