@@ -161,8 +161,9 @@ fn quilt_blocks(
                 }
             }
             // Overlap error of a candidate tile origin (sx, sy), summed in
-            // row-major order.
-            let overlap_err = |sx: usize, sy: usize| -> f32 {
+            // row-major order; once it is over `bound` the rest is skipped
+            // and infinity returned (the sum only grows).
+            let overlap_err = |sx: usize, sy: usize, bound: f32| -> f32 {
                 let lin = &padded.linear[beta(sx, sy)];
                 let base = padded.base(sx, sy);
                 let mut e = 0.0f32;
@@ -170,25 +171,48 @@ fn quilt_blocks(
                     let at = base.wrapping_add_signed(lin[i]);
                     let c = &padded.data[at..at + d];
                     e += a.iter().zip(c).map(|(p, q)| (p - q) * (p - q)).sum::<f32>();
+                    if e > bound {
+                        return f32::INFINITY;
+                    }
                 }
                 e
             };
-            // Every tile position when the tile is small, else a seeded sample.
-            let cands: Vec<(usize, usize, f32)> = if sw * sh <= o.candidates {
-                (0..sw * sh)
-                    .into_par_iter()
-                    .map(|i| (i % sw, i / sw, overlap_err(i % sw, i / sw)))
-                    .collect()
+            // Every tile position when the tile is small, else a seeded
+            // sample. A candidate is kept only when its error is within
+            // 10 % of the best, so one whose partial error is already over
+            // that much of the best seen so far (in its chunk) is out: its
+            // error is left infinite, which changes neither the best nor
+            // the kept ones.
+            let count = if sw * sh <= o.candidates {
+                sw * sh
             } else {
-                (0..o.candidates.max(1))
-                    .into_par_iter()
-                    .map(|k| {
-                        let sx = rng::index(&[o.seed, bi, k as u64, 0], sw);
-                        let sy = rng::index(&[o.seed, bi, k as u64, 1], sh);
-                        (sx, sy, overlap_err(sx, sy))
-                    })
-                    .collect()
+                o.candidates.max(1)
             };
+            let position = |k: usize| {
+                if sw * sh <= o.candidates {
+                    (k % sw, k / sw)
+                } else {
+                    (
+                        rng::index(&[o.seed, bi, k as u64, 0], sw),
+                        rng::index(&[o.seed, bi, k as u64, 1], sh),
+                    )
+                }
+            };
+            let chunks: Vec<Vec<(usize, usize, f32)>> = (0..count.div_ceil(CHUNK))
+                .into_par_iter()
+                .map(|c| {
+                    let mut best = f32::INFINITY;
+                    (c * CHUNK..((c + 1) * CHUNK).min(count))
+                        .map(|k| {
+                            let (sx, sy) = position(k);
+                            let e = overlap_err(sx, sy, keep_bound(best));
+                            best = best.min(e);
+                            (sx, sy, e)
+                        })
+                        .collect()
+                })
+                .collect();
+            let cands: Vec<(usize, usize, f32)> = chunks.into_iter().flatten().collect();
             let best = cands.iter().map(|c| c.2).fold(f32::INFINITY, f32::min);
             let good: Vec<&(usize, usize, f32)> =
                 cands.iter().filter(|c| c.2 <= keep_bound(best)).collect();
@@ -239,6 +263,9 @@ fn quilt_blocks(
     }
     map
 }
+
+/// Candidates whose overlap errors one task computes, with a running best.
+const CHUNK: usize = 256;
 
 /// The largest overlap error of a candidate kept for the random choice
 /// when the best is `best` (within 10 %, and a little more for zero).
@@ -408,7 +435,7 @@ mod tests {
 
     /// The quilt as first written: every candidate's whole overlap error,
     /// wrapping each tile lookup, tables made per call. The reference
-    /// for the padded and shared [`Quilter`].
+    /// for the padded, pruned and shared [`Quilter`].
     fn reference(
         source: &Channels,
         source_angle: &Grid<f32>,
@@ -533,7 +560,7 @@ mod tests {
     }
 
     #[test]
-    fn shared_quilting_matches_the_reference() {
+    fn pruned_and_shared_quilting_matches_the_exhaustive_reference() {
         // Smooth multi-channel tiles (so errors tie and near-tie, and the
         // 10 % band holds several candidates), turning target angles,
         // exhaustive (20×16 ≤ 400) and sampled (40×36 > 400) candidates,
