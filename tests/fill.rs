@@ -624,3 +624,113 @@ fn a_pyramid_level_is_added_only_while_every_layer_survives_halving() {
         assert_eq!(s.energy.len(), want, "{name}");
     }
 }
+
+/// A region of `outline` on the grid of a style at `px_per_unit`.
+fn region_of(
+    style: &flourish::fill::FillStyle,
+    outline: &BezPath,
+) -> flourish::fill::region::Region {
+    let mut r = flourish::fill::region::Region::rasterize(
+        Path::new("shapes.svg"),
+        "shape",
+        outline,
+        FillRule::NonZero,
+        style.px_per_unit(),
+        style.params.radius + 2,
+    )
+    .unwrap();
+    if let flourish::fill::Flow::Fixed(d) = style.flow {
+        r.direction = constant_field(r.width(), r.height(), d);
+    }
+    r
+}
+
+#[test]
+fn one_prepared_tile_serves_many_regions_as_each_alone() {
+    // The tile side of a synthesis (pyramid, channels, patch tables, padded
+    // gathers, quilting tables, Shape Hint descriptors) is made once per
+    // style and shared: each region's synthesis must be the one it gets
+    // from a preparation of its own, whatever was synthesized before it.
+    let shapes: Vec<BezPath> = vec![
+        kurbo::Circle::new((20.0, 20.0), 12.0).to_path(0.1),
+        BezPath::from_svg("M10 10 L50 14 L40 40 L14 30 Z").unwrap(),
+        kurbo::Rect::new(0.0, 0.0, 6.0, 5.0).to_path(0.1),
+    ];
+    for name in ["knot", "scales"] {
+        let style =
+            flourish::fill::FillStyle::load(&root().join("styles").join(name), Some(64)).unwrap();
+        let regions: Vec<_> = shapes.iter().map(|s| region_of(&style, s)).collect();
+        let prepared = em::Prepared::new(&style.tile, &style.params);
+        assert_eq!(prepared.tile_ink(0), style.tile.ink_fraction(0));
+        // In order, then again in reverse on the same preparation.
+        let order: Vec<usize> = (0..regions.len()).chain((0..regions.len()).rev()).collect();
+        for (i, &k) in order.iter().enumerate() {
+            let r = &regions[k];
+            let seed = 7 + k as u64;
+            let shared = prepared.synthesize(&r.direction, Some(&r.mask), seed);
+            let params = em::EmParams {
+                seed,
+                ..style.params
+            };
+            let alone = em::synthesize_in(&style.tile, &r.direction, Some(&r.mask), &params);
+            assert_eq!(shared.energy, alone.energy, "{name} region {k} (run {i})");
+            assert_eq!(shared.layers.len(), alone.layers.len());
+            for (a, b) in shared.layers.iter().zip(&alone.layers) {
+                assert_eq!(a.data(), b.data(), "{name} region {k} (run {i})");
+            }
+            assert_eq!(shared.colour.data(), alone.colour.data());
+        }
+    }
+}
+
+#[test]
+fn a_sketch_of_many_shapes_fills_each_as_its_own_synthesis_does() {
+    // Shapes in two styles, interleaved: fill_sketch prepares each style
+    // once; every region must equal the unshared synthesis with its seed,
+    // clipped as fill_sketch clips.
+    let dir = tempfile::tempdir().unwrap();
+    let body = r##"<circle cx="30" cy="30" r="14" fill="#ccc"/>
+<polygon points="60,10 90,20 80,50 55,45" fill="#ccc" data-style="scales"/>
+<circle cx="40" cy="80" r="6" fill="#ccc"/>
+<rect x="70" y="65" width="30" height="20" fill="#ccc" data-style="scales"/>
+<circle cx="150" cy="150" r="9" fill="#ccc"/>"##;
+    let path = write_sketch(dir.path(), "many.svg", body);
+    let sk = sketch::load(Path::new(&path)).unwrap();
+    let o = opts("knot");
+    let out = fill_sketch(&o, &sk).unwrap();
+    assert_eq!(out.regions.len(), 5);
+    for (qi, r) in out.regions.iter().enumerate() {
+        let name = if qi % 2 == 1 { "scales" } else { "knot" };
+        let style =
+            flourish::fill::FillStyle::load(&root().join("styles").join(name), o.resolution)
+                .unwrap();
+        let params = em::EmParams {
+            seed: flourish::pattern::rng::hash(&[o.seed, qi as u64]),
+            ..style.params
+        };
+        let s = em::synthesize_in(
+            &style.tile,
+            &r.region.direction,
+            Some(&r.region.mask),
+            &params,
+        );
+        let mut layers = s.layers;
+        for k in (1..layers.len()).rev() {
+            let (lo, hi) = layers.split_at_mut(k);
+            for (a, &b) in lo[k - 1].data_mut().iter_mut().zip(hi[0].data()) {
+                *a = a.min(b);
+            }
+        }
+        for l in &mut layers {
+            for (a, &b) in l.data_mut().iter_mut().zip(r.region.sdf.dist.data()) {
+                *a = a.max(b);
+            }
+        }
+        assert_eq!(layers.len(), r.layers.len(), "region {qi}");
+        for (a, b) in layers.iter().zip(&r.layers) {
+            assert_eq!(a.data(), b.data(), "region {qi} ({name})");
+        }
+        assert_eq!(r.tile_ink, style.tile.ink_fraction(0));
+        assert_eq!(r.energy, s.energy, "region {qi}");
+    }
+}

@@ -17,13 +17,14 @@
 //! start and after each M-step, so its decrease can be checked.
 
 use super::levelset::{self, Evolution};
-use super::patchmatch::{Channels, Match, Nnf, Patch, Problem, ShapeTerm};
-use super::quilt::{self, QuiltOptions};
-use super::shape::{self, ShapeHint};
+use super::patchmatch::{Channels, Gather, Match, Nnf, Patch, Problem, ShapeTerm};
+use super::quilt::{self, QuiltOptions, Quilter};
+use super::shape::{self, Histogram, ShapeHint};
 use super::tile::Tile;
 use crate::field::DirectionGrid;
 use crate::raster::Grid;
 use rayon::prelude::*;
+use std::sync::OnceLock;
 
 /// Parameters of the synthesis.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -91,27 +92,189 @@ pub fn synthesize(tile: &Tile, direction: &DirectionGrid, params: &EmParams) -> 
 /// [`synthesize`], searching and voting only the neighbourhoods that reach
 /// `mask` (the region, same size as `direction`); pixels no neighbourhood
 /// reaches keep their initial values. Energies count those neighbourhoods.
+///
+/// Prepares the tile on every call; to fill several regions from one tile
+/// prepare it once ([`Prepared::new`]) and call [`Prepared::synthesize`].
 pub fn synthesize_in(
     tile: &Tile,
     direction: &DirectionGrid,
     mask: Option<&Grid<bool>>,
     params: &EmParams,
 ) -> Synthesis {
-    let (width, height) = (direction.width(), direction.height());
-    let mut tiles = vec![tile.clone()];
-    while tiles.len() < params.levels {
-        let t = tiles[tiles.len() - 1].half();
-        if !represents_every_layer(&t) {
-            break;
+    Prepared::new(tile, params).synthesize(direction, mask, params.seed)
+}
+
+/// The tile side of a synthesis, which depends on the tile and the
+/// parameters but not on the target or the seed, so every region filled
+/// from one tile shares it: the tile pyramid (halved while
+/// [`represents_every_layer`]) and per level the weighted channels, the
+/// tile's direction angles (radians), its values interleaved for voting,
+/// its ink fractions, and per neighbourhood radius the rotated patch
+/// tables, the padded gather and (made when first asked) the Shape Hint
+/// descriptors of the tile's edge line.
+#[derive(Clone, Debug)]
+pub struct Prepared {
+    /// The parameters it was made for (the seed is given per synthesis).
+    params: EmParams,
+    /// Pyramid levels, finest first.
+    levels: Vec<Level>,
+}
+
+/// One pyramid level of a [`Prepared`] tile.
+#[derive(Clone, Debug)]
+struct Level {
+    tile: Tile,
+    /// [`channels_of`] the tile.
+    source: Channels,
+    /// The tile's direction angles, radians.
+    source_angle: Grid<f32>,
+    /// Per tile pixel: each layer's SDF, then the colour.
+    texels: Vec<f32>,
+    /// [`Tile::ink_fraction`] of each layer.
+    ink: Vec<f64>,
+    /// Neighbourhood sizes in the order they run.
+    scales: Vec<Scale>,
+    /// Quilting tables (the coarsest level only).
+    quilter: Option<Quilter>,
+}
+
+/// One neighbourhood radius of a [`Level`].
+#[derive(Clone, Debug)]
+struct Scale {
+    radius: usize,
+    patch: Patch,
+    gather: Gather,
+    /// Shape Hint descriptors of every tile pixel (ring `r`, bins `r/2`);
+    /// `None` for a tile without an edge line.
+    hint: OnceLock<Option<Grid<Histogram>>>,
+}
+
+impl Prepared {
+    /// Prepares `tile` for synthesis with `params` (its seed is not used).
+    pub fn new(tile: &Tile, params: &EmParams) -> Prepared {
+        let mut tiles = vec![tile.clone()];
+        while tiles.len() < params.levels {
+            let t = tiles[tiles.len() - 1].half();
+            if !represents_every_layer(&t) {
+                break;
+            }
+            tiles.push(t);
         }
-        tiles.push(t);
+        let n = tiles.len();
+        let clamp = clamp_of(params);
+        let levels = tiles
+            .into_iter()
+            .enumerate()
+            .map(|(level, t)| {
+                let source_angle = t.direction.map(|d| d[1].atan2(d[0]));
+                let source = channels_of(
+                    &t.layers.iter().map(|l| l.sdf.clone()).collect::<Vec<_>>(),
+                    &t.colour,
+                    params.alpha,
+                    clamp,
+                );
+                // Neighbourhood sizes: at the coarsest level a larger one first.
+                let max_r = (t.width().min(t.height()) / 4).max(1);
+                let mut radii = vec![params.radius.min(max_r).max(1)];
+                if level + 1 == n && n > 1 && 2 * radii[0] <= max_r {
+                    radii.insert(0, 2 * radii[0]);
+                }
+                let scales: Vec<Scale> = radii
+                    .into_iter()
+                    .map(|r| {
+                        let patch = Patch::new(r);
+                        let gather = Gather::new(&source, &patch);
+                        Scale {
+                            radius: r,
+                            patch,
+                            gather,
+                            hint: OnceLock::new(),
+                        }
+                    })
+                    .collect();
+                // The tile's layer distances and colour interleaved per
+                // pixel: one cache line per vote instead of one per grid.
+                let stride = t.layers.len() + 3;
+                let mut texels = Vec::with_capacity(t.width() * t.height() * stride);
+                for y in 0..t.height() {
+                    for x in 0..t.width() {
+                        texels.extend(t.layers.iter().map(|l| l.sdf.get(x, y)));
+                        texels.extend(t.colour.get(x, y));
+                    }
+                }
+                let ink = (0..t.layers.len()).map(|l| t.ink_fraction(l)).collect();
+                let quilter =
+                    (level + 1 == n).then(|| Quilter::new(&source, quilt_block(&t, &scales)));
+                Level {
+                    tile: t,
+                    source,
+                    source_angle,
+                    texels,
+                    ink,
+                    scales,
+                    quilter,
+                }
+            })
+            .collect();
+        Prepared {
+            params: *params,
+            levels,
+        }
     }
+
+    /// Fraction of the finest tile's pixels inside layer `m` (0 for a
+    /// layer it does not have).
+    pub fn tile_ink(&self, m: usize) -> f64 {
+        self.levels
+            .first()
+            .and_then(|l| l.ink.get(m))
+            .copied()
+            .unwrap_or(0.0)
+    }
+
+    /// [`synthesize_in`] with this tile and parameters and `seed` as the
+    /// seed of every random choice: the same result, bit for bit.
+    pub fn synthesize(
+        &self,
+        direction: &DirectionGrid,
+        mask: Option<&Grid<bool>>,
+        seed: u64,
+    ) -> Synthesis {
+        let params = EmParams {
+            seed,
+            ..self.params
+        };
+        synthesize_levels(&self.levels, direction, mask, &params)
+    }
+}
+
+/// Quilting's block side at the coarsest level, pixels: two patches of
+/// its first neighbourhood size, at most the tile.
+fn quilt_block(t: &Tile, scales: &[Scale]) -> usize {
+    let first_r = scales.first().map_or(1, |s| s.radius);
+    (4 * first_r + 2).min(t.width().min(t.height()))
+}
+
+/// The SDF clamp `K` of [`channels_of`], pixels.
+fn clamp_of(params: &EmParams) -> f32 {
+    (params.radius as f32 + 1.0).max(2.0)
+}
+
+/// The multiresolution EM over prepared levels (finest first).
+fn synthesize_levels(
+    tiles: &[Level],
+    direction: &DirectionGrid,
+    mask: Option<&Grid<bool>>,
+    params: &EmParams,
+) -> Synthesis {
+    let (width, height) = (direction.width(), direction.height());
     let levels = tiles.len();
     let mut state: Option<State> = None;
     let mut nnf: Option<Nnf> = None;
     let mut energy = Vec::new();
     for level in (0..levels).rev() {
-        let t = &tiles[level];
+        let lv = &tiles[level];
+        let t = &lv.tile;
         let f = 1usize << level;
         let (w, h) = (width.div_ceil(f).max(1), height.div_ceil(f).max(1));
         let target_angle = Grid::from_fn(w, h, |x, y| {
@@ -121,7 +284,7 @@ pub fn synthesize_in(
             );
             d[1].atan2(d[0])
         });
-        let source_angle = t.direction.map(|d| d[1].atan2(d[0]));
+        let source_angle = &lv.source_angle;
         // Squared distance to the region at this level (any pixel of a
         // block counts).
         let level_mask = mask.map(|m| {
@@ -131,34 +294,22 @@ pub fn synthesize_in(
             })
         });
         let near = level_mask.as_ref().map(crate::raster::edt::squared_edt);
-        // Neighbourhood sizes: at the coarsest level a larger one first.
-        let max_r = (t.width().min(t.height()) / 4).max(1);
-        let mut radii = vec![params.radius.min(max_r).max(1)];
-        if level + 1 == levels && levels > 1 && 2 * radii[0] <= max_r {
-            radii.insert(0, 2 * radii[0]);
-        }
-        let clamp = (params.radius as f32 + 1.0).max(2.0);
-        let source = channels_of(
-            &t.layers.iter().map(|l| l.sdf.clone()).collect::<Vec<_>>(),
-            &t.colour,
-            params.alpha,
-            clamp,
-        );
+        let first_r = lv.scales.first().map_or(1, |s| s.radius);
+        let clamp = clamp_of(params);
+        let source = &lv.source;
         let mut st = match state.take() {
             None => {
-                // Quilting with blocks of two patches.
-                let block = (4 * radii[0] + 2).min(t.width().min(t.height()));
-                let map = quilt::quilt(
-                    &source,
-                    &source_angle,
-                    &target_angle,
-                    &QuiltOptions {
-                        block,
-                        overlap: (block / 4).max(1),
-                        candidates: 4096,
-                        seed: params.seed,
-                    },
-                );
+                let block = quilt_block(t, &lv.scales);
+                let qo = QuiltOptions {
+                    block,
+                    overlap: (block / 4).max(1),
+                    candidates: 4096,
+                    seed: params.seed,
+                };
+                let map = match &lv.quilter {
+                    Some(q) => q.quilt(source, source_angle, &target_angle, &qo),
+                    None => quilt::quilt(source, source_angle, &target_angle, &qo),
+                };
                 let phi = t
                     .layers
                     .iter()
@@ -173,7 +324,7 @@ pub fn synthesize_in(
                     let (sx, sy) = map.get(x, y);
                     t.colour.get(sx as usize, sy as usize)
                 });
-                let spacing = spacing_of(radii[0]);
+                let spacing = spacing_of(first_r);
                 let (cols, rows) = Nnf::shape(w, h, spacing);
                 let matches = (0..cols * rows)
                     .map(|k| {
@@ -199,8 +350,9 @@ pub fn synthesize_in(
             Some(prev) => upsample(&prev, w, h),
         };
         let mut level_energy = Vec::new();
-        for (ri, &r) in radii.iter().enumerate() {
-            let patch = Patch::new(r);
+        for (ri, sc) in lv.scales.iter().enumerate() {
+            let r = sc.radius;
+            let patch = &sc.patch;
             let spacing = spacing_of(r);
             let mut field = resample_nnf(nnf.take(), w, h, spacing, t);
             let n = if level == 0 && levels > 1 {
@@ -214,9 +366,14 @@ pub fn synthesize_in(
             let hints = match (&level_mask, &t.edge) {
                 (Some(lm), Some(edge)) if params.shape > 0.0 => {
                     let (ring, bin) = (r as f32, (r as f32 / 2.0).max(1.0));
-                    let src = ShapeHint::new(&edge.raster(t.width(), t.height()), true, ring, bin);
+                    let src = sc.hint.get_or_init(|| {
+                        Some(
+                            ShapeHint::new(&edge.raster(t.width(), t.height()), true, ring, bin)
+                                .histograms(source_angle),
+                        )
+                    });
                     let tgt = ShapeHint::new(&shape::outline(lm), false, ring, bin);
-                    Some((src.histograms(&source_angle), tgt.histograms(&target_angle)))
+                    src.as_ref().map(|src| (src, tgt.histograms(&target_angle)))
                 }
                 _ => None,
             };
@@ -232,7 +389,14 @@ pub fn synthesize_in(
                         })
                         .collect()
                 });
-                let mut pb = Problem::new(&source, &source_angle, &target, &target_angle, &patch);
+                let mut pb = Problem::with_gather(
+                    source,
+                    source_angle,
+                    &target,
+                    &target_angle,
+                    patch,
+                    &sc.gather,
+                );
                 if let Some(a) = &active {
                     pb = pb.with_active(a);
                 }
@@ -253,8 +417,8 @@ pub fn synthesize_in(
                 pb.improve(&mut field, params.seed, round);
                 level_energy.push(interior_energy(&field, r, w, h, active.as_deref()));
                 // E-step.
-                let hist = histogram_weights(&st.phi, t, near.as_ref());
-                let votes = vote(&pb, &field, t, &hist, w, h);
+                let hist = histogram_weights(&st.phi, &lv.ink, near.as_ref());
+                let votes = vote(&pb, &field, lv, &hist, w, h);
                 // Eq. 4 sums the data force over the |s_x| overlapping
                 // neighbourhoods; the level set uses their mean, so the
                 // curvature weight is divided by |s_x| to keep Eq. 5's balance.
@@ -442,9 +606,13 @@ const HISTOGRAM_GAMMA: f32 = 4.0;
 /// the ink and paper bins of each layer: a bin over-represented in the
 /// current image relative to the tile (`H_s/H_e − 1 > 0`) has its
 /// candidates weighted `1/(1 + γ·(H_s/H_e − 1))`, so voting does not drift
-/// away from the tile's ink fraction. Counted over the region (`near` = 0)
-/// when there is one.
-fn histogram_weights(phi: &[Grid<f32>], t: &Tile, near: Option<&Grid<f32>>) -> Vec<[f32; 2]> {
+/// away from the tile's ink fraction (`tile_ink`, per layer). Counted over
+/// the region (`near` = 0) when there is one.
+fn histogram_weights(
+    phi: &[Grid<f32>],
+    tile_ink: &[f64],
+    near: Option<&Grid<f32>>,
+) -> Vec<[f32; 2]> {
     phi.iter()
         .enumerate()
         .map(|(l, g)| {
@@ -460,7 +628,7 @@ fn histogram_weights(phi: &[Grid<f32>], t: &Tile, near: Option<&Grid<f32>>) -> V
             } else {
                 0.0
             };
-            let he_ink = t.ink_fraction(l) as f32;
+            let he_ink = tile_ink.get(l).copied().unwrap_or(0.0) as f32;
             let w = |hs: f32, he: f32| {
                 if he > 0.0 {
                     1.0 / (1.0 + HISTOGRAM_GAMMA * (hs / he - 1.0).max(0.0))
@@ -523,7 +691,8 @@ fn coherence(pb: &Problem, nnf: &Nnf, k: usize) -> f32 {
 /// The E-step's gathering: every pixel collects the tile values its
 /// overlapping matched neighbourhoods put there. Rows are gathered in
 /// parallel, each scanning the centres whose patches cross it.
-fn vote(pb: &Problem, nnf: &Nnf, t: &Tile, hist: &[[f32; 2]], w: usize, h: usize) -> Votes {
+fn vote(pb: &Problem, nnf: &Nnf, lv: &Level, hist: &[[f32; 2]], w: usize, h: usize) -> Votes {
+    let t = &lv.tile;
     let per_centre: Vec<(f32, usize)> = (0..nnf.matches.len())
         .into_par_iter()
         .map(|k| {
@@ -549,16 +718,8 @@ fn vote(pb: &Problem, nnf: &Nnf, t: &Tile, hist: &[[f32; 2]], w: usize, h: usize
             v
         }
     };
-    // The tile's layer distances and colour interleaved per pixel: one
-    // cache line per vote instead of one per grid.
     let stride = layers + 3;
-    let mut tv = Vec::with_capacity(t.width() * t.height() * stride);
-    for y in 0..t.height() {
-        for x in 0..t.width() {
-            tv.extend(t.layers.iter().map(|l| l.sdf.get(x, y)));
-            tv.extend(t.colour.get(x, y));
-        }
-    }
+    let tv = &lv.texels;
     let rows: Vec<RowVote> = (0..h)
         .into_par_iter()
         .map(|y| {

@@ -284,7 +284,9 @@ pub fn fill_sketch(opts: &FillOptions, sk: &Sketch) -> Result<FillOutput> {
             return Err(Error::invalid(d, "no open stroked path to comb with"));
         }
     }
-    let mut styles: BTreeMap<String, FillStyle> = BTreeMap::new();
+    // Each style is loaded and its tile prepared for synthesis once per
+    // sketch, then shared by every region that uses it.
+    let mut styles: BTreeMap<String, (FillStyle, em::Prepared)> = BTreeMap::new();
     let mut out = Vec::new();
     let mut notes = Vec::new();
     let mut max_ppu = 1.0f64;
@@ -295,9 +297,11 @@ pub fn fill_sketch(opts: &FillOptions, sk: &Sketch) -> Result<FillOutput> {
                 Some(ds) => style::resolve_data_style(&sk.path, &q.id, ds, &opts.styles_dir)?,
                 None => style::resolve(&name, &opts.styles_dir)?,
             };
-            styles.insert(name.clone(), FillStyle::load(&dir, opts.resolution)?);
+            let st = FillStyle::load(&dir, opts.resolution)?;
+            let prepared = em::Prepared::new(&st.tile, &st.params);
+            styles.insert(name.clone(), (st, prepared));
         }
-        let st = &styles[&name];
+        let (st, prepared) = &styles[&name];
         let ppu = st.px_per_unit();
         max_ppu = max_ppu.max(ppu);
         let margin = st.params.radius + 2;
@@ -320,11 +324,8 @@ pub fn fill_sketch(opts: &FillOptions, sk: &Sketch) -> Result<FillOutput> {
             region.height(),
             region.area
         ));
-        let params = EmParams {
-            seed: crate::pattern::rng::hash(&[opts.seed, qi as u64]),
-            ..st.params
-        };
-        let syn = em::synthesize_in(&st.tile, &region.direction, Some(&region.mask), &params);
+        let seed = crate::pattern::rng::hash(&[opts.seed, qi as u64]);
+        let syn = prepared.synthesize(&region.direction, Some(&region.mask), seed);
         let mut layers = syn.layers;
         // Occlusion order: each layer extends under the layers above it.
         for k in (1..layers.len()).rev() {
@@ -357,7 +358,7 @@ pub fn fill_sketch(opts: &FillOptions, sk: &Sketch) -> Result<FillOutput> {
         out.push(RegionFill {
             id: q.id.clone(),
             colors: st.tile.layers.iter().map(|l| l.color).collect(),
-            tile_ink: st.tile.ink_fraction(0),
+            tile_ink: prepared.tile_ink(0),
             region,
             layers,
             paths,

@@ -21,6 +21,7 @@ use super::shape::{self, Histogram};
 use crate::pattern::rng;
 use crate::raster::Grid;
 use rayon::prelude::*;
+use std::borrow::Cow;
 
 /// Number of quantized rotation angles.
 pub const ANGLE_BINS: usize = 32;
@@ -173,12 +174,66 @@ pub struct Problem<'a> {
     pub target_angle: &'a Grid<f32>,
     /// Patch geometry.
     pub patch: &'a Patch,
+    gather: Cow<'a, Gather>,
+    active: Option<&'a [bool]>,
+    shape: Option<ShapeTerm<'a>>,
+}
+
+/// A tile's channels padded by their own wrap-around (a margin of
+/// `⌈r√2⌉ + 1` pixels) and, per angle bin, the linear offsets of a rotated
+/// patch into them: what a [`Problem`] gathers from. It depends only on the
+/// tile and the patch radius, so it can be built once and shared by every
+/// search against that tile ([`Problem::with_gather`]).
+#[derive(Clone, Debug)]
+pub struct Gather {
+    /// Tile width, height and depth it was built for, pixels and channels.
+    dims: (usize, usize, usize),
+    /// Patch radius it was built for, pixels.
+    radius: usize,
     padded: Vec<f32>,
     padded_width: usize,
     margin: usize,
     linear: Vec<Vec<isize>>,
-    active: Option<&'a [bool]>,
-    shape: Option<ShapeTerm<'a>>,
+}
+
+impl Gather {
+    /// Pads `source` and builds the offsets of `patch`'s rotation tables.
+    pub fn new(source: &Channels, patch: &Patch) -> Gather {
+        let margin = (patch.radius as f64 * std::f64::consts::SQRT_2).ceil() as usize + 1;
+        let (w, h, d) = (source.width, source.height, source.depth);
+        let (pw, ph) = (w + 2 * margin, h + 2 * margin);
+        let mut padded = Vec::with_capacity(pw * ph * d);
+        for y in 0..ph {
+            let sy = (y + h * (margin / h + 1) - margin) % h;
+            for x in 0..pw {
+                let sx = (x + w * (margin / w + 1) - margin) % w;
+                padded.extend_from_slice(source.px(sx, sy));
+            }
+        }
+        let linear = (0..ANGLE_BINS)
+            .map(|b| {
+                patch
+                    .table(b)
+                    .iter()
+                    .map(|&(_, _, rx, ry)| (ry as isize * pw as isize + rx as isize) * d as isize)
+                    .collect()
+            })
+            .collect();
+        Gather {
+            dims: (w, h, d),
+            radius: patch.radius,
+            padded,
+            padded_width: pw,
+            margin,
+            linear,
+        }
+    }
+
+    /// Whether this gather was built for a source of `source`'s size and
+    /// depth and a patch of `patch`'s radius.
+    pub fn fits(&self, source: &Channels, patch: &Patch) -> bool {
+        self.dims == (source.width, source.height, source.depth) && self.radius == patch.radius
+    }
 }
 
 /// The Shape Hint term of a search (Brushables Eq. 6): `weight · χ²`
@@ -204,36 +259,42 @@ impl<'a> Problem<'a> {
         target_angle: &'a Grid<f32>,
         patch: &'a Patch,
     ) -> Problem<'a> {
-        let margin = (patch.radius as f64 * std::f64::consts::SQRT_2).ceil() as usize + 1;
-        let (w, h, d) = (source.width, source.height, source.depth);
-        let (pw, ph) = (w + 2 * margin, h + 2 * margin);
-        let mut padded = Vec::with_capacity(pw * ph * d);
-        for y in 0..ph {
-            let sy = (y + h * (margin / h + 1) - margin) % h;
-            for x in 0..pw {
-                let sx = (x + w * (margin / w + 1) - margin) % w;
-                padded.extend_from_slice(source.px(sx, sy));
-            }
-        }
-        let linear = (0..ANGLE_BINS)
-            .map(|b| {
-                patch
-                    .table(b)
-                    .iter()
-                    .map(|&(_, _, rx, ry)| (ry as isize * pw as isize + rx as isize) * d as isize)
-                    .collect()
-            })
-            .collect();
         Problem {
             source,
             source_angle,
             target,
             target_angle,
             patch,
-            padded,
-            padded_width: pw,
-            margin,
-            linear,
+            gather: Cow::Owned(Gather::new(source, patch)),
+            active: None,
+            shape: None,
+        }
+    }
+
+    /// [`Problem::new`] with the padded source and gather offsets built
+    /// beforehand by [`Gather::new`]`(source, patch)` (shared by every
+    /// search against one tile, e.g. all regions of a sketch). A `gather`
+    /// of another size or radius is not used: the problem builds its own.
+    pub fn with_gather(
+        source: &'a Channels,
+        source_angle: &'a Grid<f32>,
+        target: &'a Channels,
+        target_angle: &'a Grid<f32>,
+        patch: &'a Patch,
+        gather: &'a Gather,
+    ) -> Problem<'a> {
+        let gather = if gather.fits(source, patch) {
+            Cow::Borrowed(gather)
+        } else {
+            Cow::Owned(Gather::new(source, patch))
+        };
+        Problem {
+            source,
+            source_angle,
+            target,
+            target_angle,
+            patch,
+            gather,
             active: None,
             shape: None,
         }
@@ -347,15 +408,16 @@ impl<'a> Problem<'a> {
         bound: f32,
     ) -> f32 {
         let d = self.source.depth;
-        let offsets = &self.linear[self.bin(px, py, qx, qy)];
-        let base = (((py + self.margin) * self.padded_width + px + self.margin) * d) as isize;
+        let g = &*self.gather;
+        let offsets = &g.linear[self.bin(px, py, qx, qy)];
+        let base = (((py + g.margin) * g.padded_width + px + g.margin) * d) as isize;
         let mut sum = self.shape_cost(qx, qy, px, py);
         if sum > bound {
             return sum;
         }
         for (t, &off) in tp.chunks_exact(d).zip(offsets) {
             let i = (base + off) as usize;
-            let sp = &self.padded[i..i + d];
+            let sp = &g.padded[i..i + d];
             for c in 0..d {
                 let e = sp[c] - t[c];
                 sum += e * e;
