@@ -581,19 +581,36 @@ fn scan_inside(w: usize, h: usize, shapes: &[&FlatShape]) -> Grid<bool> {
     grid
 }
 
-/// For each of `shapes`, the others whose boxes meet its box: the shapes
-/// that can bury its edges.
+/// For each of `shapes`, the others whose boxes meet its box (ascending):
+/// the shapes that can bury its edges. A sweep over the boxes sorted by
+/// their left sides compares only boxes whose x-ranges meet (50 000
+/// scattered dots: 7 M pairs, not 2.5 G).
 fn overlapping(shapes: &[&FlatShape]) -> Vec<Vec<usize>> {
-    (0..shapes.len())
-        .map(|i| {
-            (0..shapes.len())
-                .filter(|&j| {
-                    let (a, b) = (shapes[i].bbox, shapes[j].bbox);
-                    j != i && a.intersect(b).area() >= 0.0 && overlaps(a, b)
-                })
-                .collect()
-        })
-        .collect()
+    let meet = |a: kurbo::Rect, b: kurbo::Rect| a.intersect(b).area() >= 0.0 && overlaps(a, b);
+    let mut order: Vec<usize> = (0..shapes.len()).collect();
+    order.sort_by(|&i, &j| shapes[i].bbox.x0.total_cmp(&shapes[j].bbox.x0));
+    let mut out: Vec<Vec<usize>> = vec![Vec::new(); shapes.len()];
+    for (k, &i) in order.iter().enumerate() {
+        let a = shapes[i].bbox;
+        // Boxes to the right start at or after `a`'s left side; past its
+        // right side none meets it (nor does any later one).
+        for &j in &order[k + 1..] {
+            let b = shapes[j].bbox;
+            // (A NaN side meets nothing.)
+            use std::cmp::Ordering::{Equal, Less};
+            if !matches!(b.x0.partial_cmp(&a.x1), Some(Less | Equal)) {
+                break;
+            }
+            if meet(a, b) {
+                out[i].push(j);
+                out[j].push(i);
+            }
+        }
+    }
+    for list in &mut out {
+        list.sort_unstable();
+    }
+    out
 }
 
 /// The parts of the shapes' outlines that bound their union: a segment piece
@@ -884,6 +901,55 @@ mod tests {
         let round = cost(&[FlatShape::from_segments(polygon(&circle), false)], 1000);
         assert!(round.winding_reads < 2 * 20_000 * 100, "{round:?}");
         assert!(round.affordable());
+    }
+
+    /// The sweep finds exactly the pairs of meeting boxes that comparing
+    /// every pair finds.
+    #[test]
+    fn overlapping_boxes_are_found_by_the_sweep() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut shapes: Vec<FlatShape> = (0..300)
+            .map(|_| {
+                let (x, y) = (100.0 * next(), 100.0 * next());
+                let (w, h) = (8.0 * next(), 8.0 * next());
+                FlatShape::from_segments(
+                    polygon(&[(x, y), (x + w, y), (x + w, y + h), (x, y + h)]),
+                    false,
+                )
+            })
+            .collect();
+        // Touching edges meet; a shape with no segments meets nothing.
+        shapes.push(FlatShape::from_segments(
+            polygon(&[(200.0, 0.0), (210.0, 0.0), (210.0, 5.0), (200.0, 5.0)]),
+            false,
+        ));
+        shapes.push(FlatShape::from_segments(
+            polygon(&[(210.0, 5.0), (220.0, 5.0), (220.0, 9.0), (210.0, 9.0)]),
+            false,
+        ));
+        shapes.push(FlatShape::from_segments(Vec::new(), false));
+        let refs: Vec<&FlatShape> = shapes.iter().collect();
+        let brute: Vec<Vec<usize>> = (0..refs.len())
+            .map(|i| {
+                (0..refs.len())
+                    .filter(|&j| {
+                        let (a, b) = (refs[i].bbox, refs[j].bbox);
+                        j != i && a.intersect(b).area() >= 0.0 && overlaps(a, b)
+                    })
+                    .collect()
+            })
+            .collect();
+        let swept = overlapping(&refs);
+        assert_eq!(swept, brute);
+        assert!(swept.iter().map(Vec::len).sum::<usize>() > 100);
+        assert_eq!(swept[300], vec![301]);
+        assert!(swept[302].is_empty());
     }
 
     #[test]
