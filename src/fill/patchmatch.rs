@@ -259,16 +259,8 @@ impl<'a> Problem<'a> {
         target_angle: &'a Grid<f32>,
         patch: &'a Patch,
     ) -> Problem<'a> {
-        Problem {
-            source,
-            source_angle,
-            target,
-            target_angle,
-            patch,
-            gather: Cow::Owned(Gather::new(source, patch)),
-            active: None,
-            shape: None,
-        }
+        let gather = Cow::Owned(Gather::new(source, patch));
+        Problem::with(source, source_angle, target, target_angle, patch, gather)
     }
 
     /// [`Problem::new`] with the padded source and gather offsets built
@@ -288,6 +280,18 @@ impl<'a> Problem<'a> {
         } else {
             Cow::Owned(Gather::new(source, patch))
         };
+        Problem::with(source, source_angle, target, target_angle, patch, gather)
+    }
+
+    /// The problem with its gather decided, no active mask, no shape term.
+    fn with(
+        source: &'a Channels,
+        source_angle: &'a Grid<f32>,
+        target: &'a Channels,
+        target_angle: &'a Grid<f32>,
+        patch: &'a Patch,
+        gather: Cow<'a, Gather>,
+    ) -> Problem<'a> {
         Problem {
             source,
             source_angle,
