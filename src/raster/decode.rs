@@ -330,7 +330,7 @@ struct InkScale {
     /// [`INK_OUTLIERS`] of them darker still.
     ink: f32,
     /// Raw coverage up to which the paper's own grain reaches: the darkest
-    /// level of the paper's peak ([`grain_top`]); the paper itself on a
+    /// level of the paper's peak ([`paper_peak`]); the paper itself on a
     /// clean picture.
     grain: f32,
 }

@@ -361,7 +361,7 @@ const STEP_SLACK: f64 = 0.15;
 /// exceeds `limit`. Each sample's first chord within `limit` is searched
 /// from the last one found (samples and curve both run from start to end;
 /// chords out of reach are skipped by their arc length, see
-/// [`nearest_segment`]), then followed downhill to a local minimum: an upper
+/// [`nearest_segment`](super::nearest::nearest_segment)), then followed downhill to a local minimum: an upper
 /// bound of the distance, exact where the curve is smooth.
 fn outline_to_curve(curve: &CurvePoints, samples: &[(Point, Vec2)], limit: f64) -> Option<f64> {
     let (pts, cum) = (curve.points(), curve.lengths());

@@ -508,7 +508,7 @@ const OUTLINE_SLACK: f64 = 0.02;
 /// bisecting between that success and the failure above it. Extending each
 /// span as far as it goes is what an optimal cover does when fitting is
 /// monotone in the span, and it needs no merging pass afterwards. Spans
-/// shorter than [`MIN_SPAN_PX`] that still do not fit fall back to the
+/// shorter than [`MIN_SPAN_PX`](super::span::MIN_SPAN_PX) that still do not fit fall back to the
 /// polygon, which lies on the level set.
 fn fit_piece(piece: &Piece, accuracy: f64, out: &mut Vec<CubicBez>) {
     let n = piece.pts.len();

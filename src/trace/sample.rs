@@ -127,10 +127,12 @@ impl Piece<'_> {
         all.unwrap_or([(Point::ORIGIN, Vec2::ZERO); FIT_SAMPLES])
     }
 
-    /// [`Self::samples`], taken in order and given up (`None`) as soon as
-    /// `ok` rejects the tangents of two neighbouring samples: a span the
-    /// fitter refuses for bending too sharply costs only the samples up to
-    /// the bend.
+    /// Position (px) and unit tangent at `t` (a share of the length) for
+    /// each of [`FIT_SAMPLES`] points evenly spread over `range`, where
+    /// kurbo's fitter samples them, taken in order and given up (`None`)
+    /// as soon as `ok` rejects the tangents of two neighbouring samples: a
+    /// span the fitter refuses for bending too sharply costs only the
+    /// samples up to the bend.
     pub(super) fn samples_while(
         &self,
         range: Range<f64>,

@@ -282,7 +282,7 @@ pub(super) const MIN_SPAN_PX: f64 = 1.5;
 
 /// One cubic for `range` of the piece that passes the piece's checks: for
 /// an exact outline the direct fit ([`super::direct`]); for an SDF contour
-/// kurbo's fitter, with the curve also within `accuracy` + [`CHECK_SLACK`]
+/// kurbo's fitter, with the curve also within `accuracy` + [`CHECK_SLACK`](super::fit::CHECK_SLACK)
 /// of the SDF's zero level at 63 points. Either way the curve may not loop
 /// away (arc length at most 1.5× the source's) and the range must not be
 /// "spicy" (see [`is_sharp`]).
