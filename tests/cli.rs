@@ -56,6 +56,19 @@ fn flourish_guarded(dir: &Path, args: &[&str], limit: Duration) -> Output {
     child.wait_with_output().expect("collect output")
 }
 
+/// Traces `svg` into `dir`/out.svg under the hang guard (120 s, far above
+/// the second or so the run takes) and asserts it wrote paths.
+fn traces_to_paths(dir: &Path, svg: &Path) {
+    let out = dir.join("out.svg");
+    let o = flourish_guarded(
+        dir,
+        &["trace", s(svg), "-o", s(&out)],
+        Duration::from_secs(120),
+    );
+    assert!(o.status.success(), "stderr: {}", stderr(&o));
+    assert!(std::fs::read_to_string(&out).unwrap().contains("<path"));
+}
+
 /// Runs flourish with its address space capped at `mib` MiB (`ulimit -v`),
 /// so a run that allocates a huge image dies instead of answering.
 fn flourish_capped(dir: &Path, args: &[&str], mib: u64) -> Output {
@@ -410,14 +423,7 @@ fn svg_shapes_with_huge_coordinates_trace_quickly() {
 <path d="M10 10 L 1e30 1e30 L 10 20Z"/>
 <rect x="20" y="20" width="10" height="10"/></svg>"#,
     );
-    let out = t.path().join("out.svg");
-    let o = flourish_guarded(
-        t.path(),
-        &["trace", s(&p), "-o", s(&out)],
-        Duration::from_secs(120),
-    );
-    assert!(o.status.success(), "stderr: {}", stderr(&o));
-    assert!(std::fs::read_to_string(&out).unwrap().contains("<path"));
+    traces_to_paths(t.path(), &p);
 }
 
 #[test]
@@ -443,14 +449,7 @@ fn svg_long_stroked_path_traces_quickly() {
             pts.join(" ")
         ),
     );
-    let out = t.path().join("out.svg");
-    let o = flourish_guarded(
-        t.path(),
-        &["trace", s(&p), "-o", s(&out)],
-        Duration::from_secs(120),
-    );
-    assert!(o.status.success(), "stderr: {}", stderr(&o));
-    assert!(std::fs::read_to_string(&out).unwrap().contains("<path"));
+    traces_to_paths(t.path(), &p);
 }
 
 #[test]

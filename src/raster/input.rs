@@ -631,15 +631,13 @@ fn union_boundary(shapes: &[&FlatShape], others: &[Vec<usize>]) -> Vec<Line> {
                 if len <= 0.0 {
                     return None;
                 }
+                let m = l.p0.midpoint(l.p1);
+                let nrm = kurbo::Vec2::new(-d.y, d.x) / len * 0.05;
                 if lonely && !shape.even_odd {
                     // A lone nonzero shape: only self-overlaps can bury edges.
-                    let m = l.p0.midpoint(l.p1);
-                    let nrm = kurbo::Vec2::new(-d.y, d.x) / len * 0.05;
                     let (a, b) = (shape.winding(m + nrm), shape.winding(m - nrm));
                     return ((a == 0) != (b == 0)).then_some(*l);
                 }
-                let m = l.p0.midpoint(l.p1);
-                let nrm = kurbo::Vec2::new(-d.y, d.x) / len * 0.05;
                 let side = |p: Point| shape.contains(p) || others.iter().any(|o| o.contains(p));
                 (side(m + nrm) != side(m - nrm)).then_some(*l)
             })
@@ -697,6 +695,14 @@ impl ExactCost {
             }
         }
         cost
+    }
+
+    /// The cost of both (saturating).
+    fn plus(self, other: ExactCost) -> ExactCost {
+        ExactCost {
+            winding_reads: self.winding_reads.saturating_add(other.winding_reads),
+            row_crossings: self.row_crossings.saturating_add(other.row_crossings),
+        }
     }
 
     fn affordable(self) -> bool {
@@ -791,11 +797,7 @@ pub fn svg_ink(
         })
         .collect();
     let cost = sets.iter().fold(ExactCost::default(), |acc, set| {
-        let c = ExactCost::of(&set.members, &set.others, ph);
-        ExactCost {
-            winding_reads: acc.winding_reads.saturating_add(c.winding_reads),
-            row_crossings: acc.row_crossings.saturating_add(c.row_crossings),
-        }
+        acc.plus(ExactCost::of(&set.members, &set.others, ph))
     });
     if !cost.affordable() {
         // Too dense to measure exactly: read the drawing's render, as a
