@@ -8,10 +8,10 @@
 //! `cargo bench --bench brush_pipeline -- --warm-up-time 1 --measurement-time 3`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use flourish::brush::analysis::{AnalysisOptions, BrushStyle};
 use flourish::brush::output::{brush_sketch, prepared_spines, trace_query};
 use flourish::brush::pipeline::{coarse_init, BrushOptions};
 use flourish::brush::synth::{self, SynthOptions};
-use flourish::style::brush::{AnalysisOptions, BrushStyle};
 use flourish::trace::TraceOptions;
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
@@ -51,7 +51,7 @@ fn bench_pipeline(c: &mut Criterion) {
         ..AnalysisOptions::default()
     };
     let sketch_path = Path::new(env!("CARGO_MANIFEST_DIR")).join("samples/brush/s-curve.svg");
-    let sketch = flourish::sketch::load(&sketch_path).expect("sample");
+    let sketch = flourish::read::sketch::load(&sketch_path).expect("sample");
     let opts = BrushOptions::default();
     let mut g = c.benchmark_group("brush-pipeline");
     g.sample_size(10);

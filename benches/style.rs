@@ -8,7 +8,7 @@
 //! Run: `cargo bench --bench style`.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use flourish::style::brush::{AnalysisOptions, BrushStyle};
+use flourish::brush::analysis::{AnalysisOptions, BrushStyle};
 use std::hint::black_box;
 use std::path::PathBuf;
 

@@ -4,8 +4,9 @@
 //! `cargo run --release --example compare_potrace`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use flourish::raster::input::{load, InputOptions};
-use flourish::trace::{contour, trace_file, trace_sdf, TraceOptions};
+use flourish::raster::contour;
+use flourish::read::ink::{load, InputOptions};
+use flourish::trace::{trace_file, trace_sdf, TraceOptions};
 use std::hint::black_box;
 use std::path::PathBuf;
 

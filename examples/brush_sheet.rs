@@ -4,9 +4,9 @@
 //! `docs/brush-STYLE.png`. Run with
 //! `cargo run --release --example brush_sheet`.
 
+use flourish::brush::analysis::{AnalysisOptions, BrushStyle};
 use flourish::brush::output::brush_sketch;
 use flourish::brush::pipeline::BrushOptions;
-use flourish::style::brush::{AnalysisOptions, BrushStyle};
 use std::path::Path;
 
 /// The content of an SVG document, without its outer `<svg>` element.
@@ -31,7 +31,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mut width: f64 = 0.0;
         for s in ["s-curve", "meander"] {
             let path = root.join("samples/brush").join(format!("{s}.svg"));
-            let sketch = flourish::sketch::load(&path)?;
+            let sketch = flourish::read::sketch::load(&path)?;
             let text = std::fs::read_to_string(&path)?;
             let art = brush_sketch(
                 &style,
@@ -64,7 +64,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{width}\" height=\"{y}\" viewBox=\"0 0 {width} {y}\">{rows}</svg>"
         );
         let out = root.join("docs").join(format!("brush-{st}.png"));
-        let tree = flourish::io::parse_svg(&out, svg.as_bytes())?;
+        let tree = flourish::read::svg::parse_svg(&out, svg.as_bytes())?;
         let pixmap =
             flourish::render::render_tree(&out, &tree, Some(1200), Some([255, 255, 255, 255]))?;
         let png = pixmap.encode_png()?;

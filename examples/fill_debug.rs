@@ -15,7 +15,7 @@
 use flourish::fill::em::{synthesize_in, EmParams};
 use flourish::fill::region::Region;
 use flourish::fill::FillStyle;
-use flourish::sketch::{self, QueryKind};
+use flourish::read::sketch::{self, QueryKind};
 use std::path::Path;
 use std::time::Instant;
 

@@ -81,7 +81,7 @@ fn cell(x: usize, y: usize, size: usize, body: &str) -> String {
 
 /// Renders SVG text `svg` at `width` px wide into the PNG file `out`.
 fn write_png(out: &Path, svg: &str, width: u32) -> Result<(), Box<dyn std::error::Error>> {
-    let tree = flourish::io::parse_svg(out, svg.as_bytes())?;
+    let tree = flourish::read::svg::parse_svg(out, svg.as_bytes())?;
     let pixmap = render_tree(out, &tree, Some(width), None)?;
     std::fs::write(out, pixmap.encode_png()?)?;
     println!("{}", out.display());

@@ -4,7 +4,7 @@
 //! Run: `cargo run --example make_pattern_styles` (writes `styles/` and
 //! `samples/pattern/` under the crate root).
 
-use flourish::pattern::rng::unit;
+use flourish::rng::unit;
 use std::f64::consts::PI;
 use std::fmt::Write as _;
 use std::path::Path;

@@ -6,7 +6,9 @@
 //! cargo run --release --example trace_phases [-- FILE.png [RUNS]]
 //! ```
 
-use flourish::raster::{binary, corridor::Corridor, input, paths, Grid};
+use flourish::outline::{corridor::Corridor, paths, smooth as binary};
+use flourish::raster::Grid;
+use flourish::read::ink as input;
 use flourish::trace::{self, TraceOptions};
 use std::time::Instant;
 

@@ -38,8 +38,8 @@ impl DiffReport {
 /// Renders both SVG texts at the same pixel size (the first one's, scaled to
 /// [`DIFF_SIDE`]) over white and compares them pixel by pixel.
 pub fn diff_svg_texts(a_name: &Path, a: &[u8], b_name: &Path, b: &[u8]) -> Result<DiffReport> {
-    let ta = io::parse_svg(a_name, a)?;
-    let tb = io::parse_svg(b_name, b)?;
+    let ta = crate::read::svg::parse_svg(a_name, a)?;
+    let tb = crate::read::svg::parse_svg(b_name, b)?;
     let (sa, sb) = (ta.size(), tb.size());
     if (sa.width() - sb.width()).abs() > 1e-3 || (sa.height() - sb.height()).abs() > 1e-3 {
         return Err(Error::invalid(

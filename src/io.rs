@@ -3,8 +3,6 @@
 //! leaves a partial output).
 
 use crate::error::{Error, Result};
-use resvg::usvg;
-use std::borrow::Cow;
 use std::io::Write as _;
 use std::path::Path;
 
@@ -75,91 +73,6 @@ fn read_capped(path: &Path, cap: u64) -> Result<Vec<u8>> {
     Ok(out)
 }
 
-/// usvg options that never touch the file system or the network: external
-/// and embedded images are ignored, no fonts are loaded.
-pub fn svg_options() -> usvg::Options<'static> {
-    usvg::Options {
-        resources_dir: None,
-        image_href_resolver: usvg::ImageHrefResolver {
-            resolve_data: Box::new(|_, _, _| None),
-            resolve_string: Box::new(|_, _| None),
-        },
-        ..usvg::Options::default()
-    }
-}
-
-/// SVG bytes as plain text bytes: SVGZ (gzip) inflated, refusing more
-/// than [`MAX_FILE_BYTES`] once inflated (a small file can inflate a
-/// thousandfold); plain SVG as it is. `path` names the file in errors.
-pub fn inflate_svgz<'a>(path: &Path, data: &'a [u8]) -> Result<Cow<'a, [u8]>> {
-    inflate_capped(path, data, MAX_FILE_BYTES)
-}
-
-fn inflate_capped<'a>(path: &Path, data: &'a [u8], cap: u64) -> Result<Cow<'a, [u8]>> {
-    use std::io::Read as _;
-    if !data.starts_with(&[0x1f, 0x8b]) {
-        return Ok(Cow::Borrowed(data));
-    }
-    let mut out = Vec::new();
-    flate2::read::GzDecoder::new(data)
-        .take(cap + 1)
-        .read_to_end(&mut out)
-        .map_err(|e| Error::Svg {
-            path: path.to_path_buf(),
-            reason: format!("SVGZ does not inflate: {e}"),
-        })?;
-    if out.len() as u64 > cap {
-        return Err(Error::invalid(
-            path,
-            format!("SVGZ inflates to more than the limit of {cap} bytes"),
-        ));
-    }
-    Ok(Cow::Owned(out))
-}
-
-/// Parses SVG bytes (plain or SVGZ, see [`inflate_svgz`]) with
-/// [`svg_options`]; `path` names the file in errors.
-pub fn parse_svg(path: &Path, data: &[u8]) -> Result<usvg::Tree> {
-    let data = inflate_svgz(path, data)?;
-    let tree = usvg::Tree::from_data(&data, &svg_options()).map_err(|e| Error::Svg {
-        path: path.to_path_buf(),
-        reason: e.to_string(),
-    })?;
-    let size = tree.size();
-    if !(size.width().is_finite() && size.height().is_finite()) {
-        return Err(Error::invalid(path, "SVG size is not finite"));
-    }
-    Ok(tree)
-}
-
-/// The warning for plain SVG data (already inflated, see
-/// [`inflate_svgz`]) that draws `<text>`: usvg drops text, as no fonts are
-/// read, so callers say it is missing. Text inside `<defs>` (drawn only
-/// where used) is not counted.
-pub fn text_left_out(data: &[u8]) -> Option<&'static str> {
-    let text = std::str::from_utf8(data).ok()?;
-    if !text.contains("text") {
-        return None;
-    }
-    let opts = usvg::roxmltree::ParsingOptions {
-        allow_dtd: true,
-        ..Default::default()
-    };
-    const SVG: &str = "http://www.w3.org/2000/svg";
-    let drawn = usvg::roxmltree::Document::parse_with_options(text, opts).is_ok_and(|doc| {
-        doc.descendants().any(|n| {
-            n.has_tag_name((SVG, "text")) && !n.ancestors().any(|a| a.has_tag_name((SVG, "defs")))
-        })
-    });
-    drawn.then_some("its text is left out (no fonts are read): convert text to paths first")
-}
-
-/// Reads and parses an SVG file.
-pub fn load_svg(path: &Path) -> Result<usvg::Tree> {
-    let data = read_file(path)?;
-    parse_svg(path, &data)
-}
-
 /// Writes `bytes` to `path` atomically: into a temporary file in the same
 /// folder, then renamed over `path`. `-` writes to standard output.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
@@ -225,12 +138,6 @@ pub fn same_file(a: &Path, b: &Path) -> bool {
 mod tests {
     use super::*;
 
-    fn gzip(data: &[u8]) -> Vec<u8> {
-        let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
-        enc.write_all(data).expect("compresses");
-        enc.finish().expect("compresses")
-    }
-
     /// A file is read up to the cap and refused past it, named in the
     /// error (a device such as /dev/zero has no size to check first).
     #[test]
@@ -244,32 +151,5 @@ mod tests {
             e.to_string().contains("big.svg") && e.to_string().contains("limit"),
             "{e}"
         );
-    }
-
-    /// SVGZ inflates to the SVG it holds, plain SVG passes as it is, and
-    /// what inflates past the cap (a small file of zeros) or is not gzip
-    /// after its magic is refused with the file named.
-    #[test]
-    fn svgz_inflates_within_its_cap() {
-        let path = Path::new("art.svgz");
-        let svg = br#"<svg xmlns="http://www.w3.org/2000/svg" width="10" height="10"/>"#;
-        assert_eq!(
-            &*inflate_capped(path, &gzip(svg), 1000).expect("inflates"),
-            svg
-        );
-        assert!(matches!(
-            inflate_capped(path, svg, 1).expect("plain"),
-            Cow::Borrowed(_)
-        ));
-        let bomb = gzip(&vec![0u8; 100_000]);
-        assert!(bomb.len() < 1000);
-        let e = inflate_capped(path, &bomb, 10_000).expect_err("over the cap");
-        assert!(
-            e.to_string().contains("art.svgz") && e.to_string().contains("limit"),
-            "{e}"
-        );
-        let e = inflate_capped(path, &[0x1f, 0x8b, 1, 2, 3], 1000).expect_err("not gzip");
-        assert!(e.to_string().contains("art.svgz"), "{e}");
-        assert!(parse_svg(path, &gzip(svg)).is_ok());
     }
 }

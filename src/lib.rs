@@ -17,13 +17,13 @@ pub mod error;
 pub mod field;
 pub mod fill;
 pub mod io;
+pub mod outline;
 pub mod pattern;
 pub mod raster;
+pub mod read;
 pub mod render;
-pub mod sketch;
-pub mod style;
+pub mod rng;
 pub mod svg_out;
-pub mod synth;
 pub mod trace;
 
 pub use error::{Error, Result};

@@ -4,7 +4,7 @@
 use clap::{Args, Parser, Subcommand};
 use flourish::fill::{self, FillOptions};
 use flourish::pattern::{self, PatternOptions};
-use flourish::raster::input::InputOptions;
+use flourish::read::ink::InputOptions;
 use flourish::trace::TraceOptions;
 use flourish::{diff, io, render, trace, Error};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -312,8 +312,12 @@ fn run_trace(args: TraceArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
 
 /// Reads a sketch and reports what it skipped: warnings unless `quiet`,
 /// notes under `verbose`.
-fn load_sketch(path: &Path, quiet: bool, verbose: bool) -> Result<flourish::sketch::Sketch, Error> {
-    let sk = flourish::sketch::load(path)?;
+fn load_sketch(
+    path: &Path,
+    quiet: bool,
+    verbose: bool,
+) -> Result<flourish::read::sketch::Sketch, Error> {
+    let sk = flourish::read::sketch::load(path)?;
     if !quiet {
         for w in &sk.warnings {
             eprintln!("flourish: warning: {}: {w}", path.display());
@@ -350,7 +354,7 @@ fn make_folder(dir: &Path) -> Result<(), Failure> {
 /// The `--styles` folder, or the default styles folder.
 fn styles_dir(arg: &Option<PathBuf>) -> PathBuf {
     arg.clone()
-        .unwrap_or_else(flourish::style::default_styles_dir)
+        .unwrap_or_else(flourish::read::style::default_styles_dir)
 }
 
 fn run_pattern(args: PatternArgs, quiet: bool, verbose: bool) -> Result<(), Failure> {
@@ -406,8 +410,8 @@ fn run_fill(args: FillArgs, quiet: bool, verbose: bool) -> Result<(), Failure> {
 }
 
 fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure> {
+    use flourish::brush::analysis::{AnalysisOptions, BrushStyle};
     use flourish::brush::{output::brush_sketch, pipeline::BrushOptions};
-    use flourish::style::brush::{AnalysisOptions, BrushStyle};
     if args.variations == 0 || args.variations > 100 {
         return Err(Failure::Usage("--variations must be in 1..=100".into()));
     }
@@ -426,7 +430,7 @@ fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
         ));
     }
     let styles = styles_dir(&args.styles);
-    let dir = flourish::style::resolve(&args.style, &styles)?;
+    let dir = flourish::read::style::resolve(&args.style, &styles)?;
     let analysis = AnalysisOptions {
         cache_dir: args.cache.clone(),
         ..AnalysisOptions::default()
@@ -679,7 +683,8 @@ fn run_diff(args: DiffArgs, quiet: bool) -> Result<(), Failure> {
 }
 
 fn run_style_check(args: StyleCheckArgs, quiet: bool) -> Result<(), Failure> {
-    use flourish::style::{self, brush, check};
+    use flourish::brush::analysis::{self as brush, check};
+    use flourish::read::style;
     let styles_dir = args.styles.unwrap_or_else(style::default_styles_dir);
     let dir = style::resolve(&args.style, &styles_dir)?;
     if let Some(sheet) = &args.sheet {

@@ -45,7 +45,7 @@ pub fn write_preview(svg: &str, out: &Path) -> Result<()> {
 /// Renders SVG text on white as PNG bytes (documents smaller than 512 px
 /// are enlarged to 512 px); `out` names the preview in errors.
 pub fn preview_png(svg: &str, out: &Path) -> Result<Vec<u8>> {
-    let tree = io::parse_svg(out, svg.as_bytes())?;
+    let tree = crate::read::svg::parse_svg(out, svg.as_bytes())?;
     let longest = tree.size().width().max(tree.size().height());
     // Previews of tiny documents are enlarged to a readable size.
     let max_side = if longest < 512.0 { Some(512) } else { None };

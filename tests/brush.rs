@@ -5,13 +5,13 @@
 //! comparison with the art-brush baseline, determinism, and bad input.
 
 mod golden_file;
+use flourish::brush::analysis::{AnalysisOptions, BrushStyle};
 use flourish::brush::output::{
     brush_sketch, components, final_layers, smallest_exemplar_component,
 };
 use flourish::brush::pipeline::{brush_query, BrushOptions, QueryResult};
 use flourish::brush::synth::{self, Coord, Field, SynthOptions};
 use flourish::raster::Grid;
-use flourish::style::brush::{AnalysisOptions, BrushStyle};
 use kurbo::Point;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -52,8 +52,8 @@ fn style(name: &str) -> &'static BrushStyle {
     &all[i]
 }
 
-fn sketch(name: &str) -> flourish::sketch::Sketch {
-    flourish::sketch::load(&root().join("samples/brush").join(format!("{name}.svg")))
+fn sketch(name: &str) -> flourish::read::sketch::Sketch {
+    flourish::read::sketch::load(&root().join("samples/brush").join(format!("{name}.svg")))
         .expect("sample loads")
 }
 
@@ -405,7 +405,7 @@ fn flourish_keeps_the_exemplars_structure_where_the_art_brush_drifts() {
         let (_d, path) = temp_sketch(
             r##"<path d="M20 100 C 60 20, 100 20, 130 90 S 200 180, 240 100 S 300 20, 340 100 S 380 170, 390 120" fill="none" stroke="#000" stroke-width="9"/>"##,
         );
-        let sk = flourish::sketch::load(&path).unwrap();
+        let sk = flourish::read::sketch::load(&path).unwrap();
         let mut figures = Vec::new();
         for art in [false, true] {
             let opts = BrushOptions {
@@ -509,7 +509,7 @@ fn temp_sketch(body: &str) -> (tempfile::TempDir, PathBuf) {
 }
 
 fn brush_file(p: &Path) -> flourish::Result<flourish::brush::output::BrushOutput> {
-    let sk = flourish::sketch::load(p)?;
+    let sk = flourish::read::sketch::load(p)?;
     brush_sketch(style("doodle"), &sk, &BrushOptions::default())
 }
 

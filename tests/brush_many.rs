@@ -3,11 +3,11 @@
 //! around its ornament, and both give what the per-query, whole-canvas
 //! reading gives.
 
+use flourish::brush::analysis::{AnalysisOptions, BrushStyle};
 use flourish::brush::output::{brush_sketch, extend_field, trace_query};
 use flourish::brush::pipeline::BrushOptions;
 use flourish::brush::synth::{self, Coord, Field};
 use flourish::raster::Grid;
-use flourish::style::brush::{AnalysisOptions, BrushStyle};
 use flourish::trace::TraceOptions;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -146,7 +146,7 @@ fn many_small_strokes_each_trace_as_alone() {
     let svg = format!(
         r#"<svg xmlns="http://www.w3.org/2000/svg" width="160" height="60" viewBox="0 0 160 60">{body}</svg>"#
     );
-    let sk = flourish::sketch::parse(Path::new("many.svg"), svg.as_bytes()).expect("parses");
+    let sk = flourish::read::sketch::parse(Path::new("many.svg"), svg.as_bytes()).expect("parses");
     let out = brush_sketch(style, &sk, &BrushOptions::default()).expect("brushes");
     assert_eq!(out.queries.len(), 6);
     assert_eq!(out.document.groups.len(), 6);

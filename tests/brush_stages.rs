@@ -112,7 +112,7 @@ fn sketch_spine() -> QuerySpine {
     let svg = r##"<svg xmlns="http://www.w3.org/2000/svg" width="320" height="160" viewBox="0 0 320 160">
         <path id="vine" d="M20 110 C 80 20, 140 20, 170 80 S 260 150, 300 60" fill="none" stroke="#000" stroke-width="10"/>
     </svg>"##;
-    let sk = flourish::sketch::parse(Path::new("vine.svg"), svg.as_bytes()).expect("parses");
+    let sk = flourish::read::sketch::parse(Path::new("vine.svg"), svg.as_bytes()).expect("parses");
     let set = query::spines(&sk, &QueryOptions::default()).expect("spines");
     assert!(set.warnings.is_empty(), "{:?}", set.warnings);
     set.spines.into_iter().next().expect("one spine")

@@ -158,7 +158,7 @@ fn assert_no_temp_files(dir: &Path) {
 /// Parses SVG output with the library's own parser and checks its size.
 #[track_caller]
 fn parse_output(svg: &[u8]) -> flourish::Result<resvg::usvg::Tree> {
-    flourish::io::parse_svg(Path::new("output.svg"), svg)
+    flourish::read::svg::parse_svg(Path::new("output.svg"), svg)
 }
 
 fn tempdir() -> tempfile::TempDir {
@@ -1729,7 +1729,7 @@ fn data_style_reads_only_the_styles_folder() {
     let t = tempdir();
     let styles = t.path().join("styles");
     std::fs::create_dir(&styles).unwrap();
-    let shipped = flourish::style::default_styles_dir();
+    let shipped = flourish::read::style::default_styles_dir();
     for (cmd, style) in [("pattern", "stipple"), ("fill", "knot")] {
         let outside = shipped.join(style);
         for (name, cause) in [

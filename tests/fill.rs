@@ -9,7 +9,7 @@ mod golden_file;
 use flourish::field::diffusion::constant_field;
 use flourish::fill::tile::{SourceDirection, Tile};
 use flourish::fill::{em, fill_sketch, FillOptions, FillOutput};
-use flourish::sketch;
+use flourish::read::sketch;
 use flourish::svg_out::FillRule;
 use kurbo::{BezPath, Line, ParamCurve, PathSeg, Point, Shape as _};
 use std::path::{Path, PathBuf};
@@ -50,7 +50,7 @@ fn run_full(style: &str, name: &str) -> FillOutput {
 /// Distance from `p` to the outline's flattened segments.
 fn outline_distance(outline: &BezPath, p: Point) -> f64 {
     let mut segs: Vec<Line> = Vec::new();
-    flourish::raster::input::flatten_segments(outline, 0.01, &mut segs);
+    flourish::raster::vector::flatten_segments(outline, 0.01, &mut segs);
     segs.iter()
         .map(|l| flourish::raster::sdf::point_segment_distance(p, *l))
         .fold(f64::INFINITY, f64::min)
@@ -705,7 +705,7 @@ fn a_sketch_of_many_shapes_fills_each_as_its_own_synthesis_does() {
             flourish::fill::FillStyle::load(&root().join("styles").join(name), o.resolution)
                 .unwrap();
         let params = em::EmParams {
-            seed: flourish::pattern::rng::hash(&[o.seed, qi as u64]),
+            seed: flourish::rng::hash(&[o.seed, qi as u64]),
             ..style.params
         };
         let s = em::synthesize_in(

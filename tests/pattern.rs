@@ -7,8 +7,8 @@ mod golden_file;
 use flourish::pattern::element::load_example;
 use flourish::pattern::seeds::{self, Region};
 use flourish::pattern::{cluster, PatternOptions, PatternStyle};
-use flourish::sketch::{self, QueryKind};
-use flourish::style::FitPoints;
+use flourish::read::sketch::{self, QueryKind};
+use flourish::read::style::FitPoints;
 use flourish::svg_out::FillRule;
 use kurbo::{Affine, BezPath, PathEl, Point, Shape as _};
 use resvg::usvg;
@@ -182,7 +182,7 @@ fn no_element_centre_leaves_its_region() {
 /// units): the same curve gives the same points however it is written
 /// (quads as cubics, straight cubics as lines).
 fn points_of(p: &usvg::Path, n: usize) -> Vec<Point> {
-    let bp = sketch::to_bezpath(p.data(), p.abs_transform());
+    let bp = flourish::read::svg::to_bezpath(p.data(), p.abs_transform());
     let mut pts: Vec<Vec<Point>> = Vec::new();
     kurbo::flatten(&bp, 1e-5, |el| match el {
         PathEl::MoveTo(a) => pts.push(vec![a]),
@@ -268,10 +268,11 @@ fn every_output_element_is_an_exact_rigid_copy() {
         let text = out.to_document().to_svg();
         // The example and the output, both read back independently.
         let ex_path = root().join("styles").join(style).join("example.svg");
-        let ex_tree = flourish::io::load_svg(&ex_path).unwrap();
+        let ex_tree = flourish::read::svg::load_svg(&ex_path).unwrap();
         let mut ex_paths = Vec::new();
         paths(ex_tree.root(), &mut ex_paths);
-        let out_tree = flourish::io::parse_svg(Path::new("out.svg"), text.as_bytes()).unwrap();
+        let out_tree =
+            flourish::read::svg::parse_svg(Path::new("out.svg"), text.as_bytes()).unwrap();
         let mut out_paths = Vec::new();
         paths(out_tree.root(), &mut out_paths);
         let q = &out.queries[0];

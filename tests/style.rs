@@ -5,8 +5,8 @@
 //!
 //! Small styles are written by the tests into temporary folders.
 
-use flourish::style::brush::{AnalysisOptions, BrushStyle};
-use flourish::style::cache::CacheStatus;
+use flourish::brush::analysis::cache::CacheStatus;
+use flourish::brush::analysis::{AnalysisOptions, BrushStyle};
 use std::path::Path;
 use std::process::{Command, Output, Stdio};
 

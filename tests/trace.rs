@@ -1,9 +1,9 @@
 //! End-to-end properties of `flourish trace` on the project's own sample
 //! images (samples/trace/), and the golden files in golden/trace/.
 
-use flourish::raster::input::{load, InputOptions};
+use flourish::read::ink::{load, InputOptions};
 use flourish::trace::{trace_file, trace_ink, trace_sdf, TraceOptions};
-use flourish::{diff, io, render};
+use flourish::{diff, render};
 use kurbo::{ParamCurve, PathSeg};
 use proptest::prelude::*;
 use std::path::{Path, PathBuf};
@@ -92,7 +92,8 @@ fn displaced_artwork_iou(svg: &Path, input: &[bool], side: u32, shift: f64) -> f
                 shift * a.sin(),
                 &text[open..close]
             );
-            let tree = io::parse_svg(svg, moved.as_bytes()).expect("moved artwork parses");
+            let tree = flourish::read::svg::parse_svg(svg, moved.as_bytes())
+                .expect("moved artwork parses");
             let pix = render::render_tree(svg, &tree, Some(side), Some([255, 255, 255, 255]))
                 .expect("renders");
             let out: Vec<bool> = pix.data().chunks(4).map(|p| p[0] < 128).collect();
@@ -128,7 +129,7 @@ fn rendered_output_reproduces_the_bitmap() {
         };
         let doc = trace_file(&path, &InputOptions::default(), &opts).expect("traces");
         let svg = doc.to_svg();
-        let tree = io::parse_svg(&path, svg.as_bytes()).expect("output parses");
+        let tree = flourish::read::svg::parse_svg(&path, svg.as_bytes()).expect("output parses");
         let pix =
             render::render_tree(&path, &tree, None, Some([255, 255, 255, 255])).expect("renders");
         assert_eq!((pix.width(), pix.height()), (img.width(), img.height()));
@@ -207,7 +208,7 @@ fn colour_layers_stack_back_into_the_picture() {
     assert!(doc.groups.len() >= 2, "{} layers", doc.groups.len());
     let img = image::open(&path).expect("png").to_rgb8();
     let svg = doc.to_svg();
-    let tree = io::parse_svg(&path, svg.as_bytes()).expect("parses");
+    let tree = flourish::read::svg::parse_svg(&path, svg.as_bytes()).expect("parses");
     let pix = render::render_tree(&path, &tree, None, Some([255, 255, 255, 255])).expect("renders");
     let mut close = 0usize;
     for (p, q) in img.pixels().zip(pix.data().chunks(4)) {
@@ -242,7 +243,7 @@ fn all_inks_trace_to_one_silhouette_as_the_svg_does() {
             "{name}: mixed inks are filled black"
         );
         let svg = doc.to_svg();
-        let tree = io::parse_svg(&path, svg.as_bytes()).expect("parses");
+        let tree = flourish::read::svg::parse_svg(&path, svg.as_bytes()).expect("parses");
         let pix = render::render_tree(&path, &tree, Some(512), Some([255, 255, 255, 255]))
             .expect("renders");
         pix.data().chunks(4).map(|p| p[0] < 128).collect()
@@ -353,7 +354,7 @@ proptest! {
             }
         }
         let svg = doc.to_svg();
-        prop_assert!(io::parse_svg(&p, svg.as_bytes()).is_ok());
+        prop_assert!(flourish::read::svg::parse_svg(&p, svg.as_bytes()).is_ok());
     }
 }
 
@@ -368,9 +369,9 @@ proptest! {
 /// smoothed loops fitted together.
 #[test]
 fn outline_curves_stay_within_tolerance_of_their_reference() {
-    use flourish::raster::binary::bitmap_loops;
-    use flourish::raster::corridor::Corridor;
-    use flourish::raster::input::{load_traceable, LayerOutline, Traceable};
+    use flourish::outline::corridor::Corridor;
+    use flourish::outline::smooth::bitmap_loops;
+    use flourish::read::ink::{load_traceable, LayerOutline, Traceable};
     use flourish::trace::{trace_bitmap, trace_outline};
     let opts = TraceOptions::default();
     let slack = 0.05;
@@ -639,7 +640,8 @@ fn binary_hairlines_keep_their_weight() {
 /// before), a 3-pixel speck goes, and `--min-area 3` keeps it.
 #[test]
 fn specks_are_measured_in_pixels() {
-    use flourish::raster::{binary, Grid};
+    use flourish::outline::smooth as binary;
+    use flourish::raster::Grid;
     use flourish::trace::trace_outline;
     // A 2 × 2 dot, a 3-pixel L and an 8 × 8 square with a 2 × 2 hole.
     let ink = |x: usize, y: usize| {
@@ -827,10 +829,9 @@ fn rendered_svg_leaves_out_the_spine_in_place() {
 <path id="spine" d="M5 90 L95 90" stroke="#000" stroke-width="4" fill="none"/>
 </svg>"##;
     let path = Path::new("exemplar.svg");
-    let tree = io::parse_svg(path, svg.as_bytes()).expect("parses");
-    let ink =
-        flourish::raster::input::svg_ink(path, &tree, &InputOptions::default(), Some("spine"))
-            .expect("ink");
+    let tree = flourish::read::svg::parse_svg(path, svg.as_bytes()).expect("parses");
+    let ink = flourish::read::ink::svg_ink(path, &tree, &InputOptions::default(), Some("spine"))
+        .expect("ink");
     let doc = trace_ink(&ink, &TraceOptions::default()).expect("traces");
     let loops = traced_subpaths(&doc);
     assert_eq!(loops.len(), 1, "{} loops", loops.len());
@@ -914,7 +915,8 @@ fn a_photographed_drawing_traces_as_the_drawing_under_uneven_light() {
             let doc = trace_file(&path, &InputOptions::default(), &TraceOptions::default())
                 .expect("traces");
             let svg = doc.to_svg();
-            let tree = io::parse_svg(&path, svg.as_bytes()).expect("output parses");
+            let tree =
+                flourish::read::svg::parse_svg(&path, svg.as_bytes()).expect("output parses");
             let pix = render::render_tree(&path, &tree, None, Some([255, 255, 255, 255]))
                 .expect("renders");
             let got: Vec<bool> = pix.data().chunks(4).map(|p| p[0] < 128).collect();
@@ -1039,7 +1041,7 @@ fn a_dense_scribble_traces_from_its_render() {
         doc.notes
     );
     let render = |text: &str| -> Vec<bool> {
-        let tree = io::parse_svg(&p, text.as_bytes()).expect("parses");
+        let tree = flourish::read::svg::parse_svg(&p, text.as_bytes()).expect("parses");
         render::render_tree(&p, &tree, Some(512), Some([255, 255, 255, 255]))
             .expect("renders")
             .data()
@@ -1069,7 +1071,7 @@ fn grainy_paper_keeps_hairlines_whole() {
     let side = 4 * image::open(&clean_path).expect("png").width();
     // Renders of an SVG at 4×, cut halfway between white and its ink.
     let render_4x = |path: &Path, svg: &str| -> Vec<bool> {
-        let tree = io::parse_svg(path, svg.as_bytes()).expect("parses");
+        let tree = flourish::read::svg::parse_svg(path, svg.as_bytes()).expect("parses");
         let pix = render::render_tree(path, &tree, Some(side), Some([255, 255, 255, 255]))
             .expect("renders");
         let darkest = pix.data().chunks(4).map(|p| p[0]).min().unwrap_or(0);

@@ -9,10 +9,10 @@
 //! [`rasterize_coords`] turns it into the same coordinate field as the
 //! ARAP stage, which the brush pipeline and its tests compare against.
 
+use crate::brush::analysis::uv::tangents;
 use crate::brush::arap::{rasterize_coords, RibMesh};
 use crate::error::{Error, Result};
 use crate::raster::Grid;
-use crate::style::uv::tangents;
 use kurbo::{Affine, Point, Vec2};
 
 /// Cumulative arc length at each vertex of a polyline.

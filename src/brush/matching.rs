@@ -35,7 +35,7 @@
 
 use crate::brush::query::QuerySpine;
 use crate::error::{Error, Result};
-use crate::pattern::rng;
+use crate::rng;
 use kurbo::Point;
 use std::collections::HashMap;
 use std::ops::Range;

@@ -479,7 +479,7 @@ mod tests {
             seed in any::<u64>(),
         ) {
             let n = w * h + 2;
-            let r = |i: usize, k: u64| crate::pattern::rng::hash(&[seed, i as u64, k]);
+            let r = |i: usize, k: u64| crate::rng::hash(&[seed, i as u64, k]);
             let mut edges = Vec::new();
             for p in 0..w * h {
                 let (x, y) = (p % w, p / w);
@@ -509,7 +509,7 @@ mod tests {
         // left and right columns.
         let (w, h) = (60, 40);
         let n = w * h + 2;
-        let cap = |i: usize, k: u64| (crate::pattern::rng::hash(&[i as u64, k]) % 50) as i64;
+        let cap = |i: usize, k: u64| (crate::rng::hash(&[i as u64, k]) % 50) as i64;
         let mut edges = Vec::new();
         for y in 0..h {
             for x in 0..w {

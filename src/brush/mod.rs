@@ -23,6 +23,7 @@
 //! - [`baseline`]: the "art brush" reference, one exemplar stretched along
 //!   the whole query.
 
+pub mod analysis;
 pub mod arap;
 pub mod baseline;
 pub mod graphcut;

@@ -6,10 +6,10 @@
 use super::pipeline::{as_branch, brush_query, starts_on, BrushOptions, QueryResult};
 use super::query::{self, QuerySpine};
 use super::synth::{self, Coord, Field};
+use crate::brush::analysis::BrushStyle;
 use crate::error::{Error, Result};
 use crate::raster::{Grid, Sdf};
-use crate::sketch::Sketch;
-use crate::style::brush::BrushStyle;
+use crate::read::sketch::Sketch;
 use crate::svg_out::{decimals_for, Color, Document, FillRule, Group, Shape};
 use crate::trace::{trace_sdf, TraceOptions};
 use rayon::prelude::*;
@@ -565,7 +565,7 @@ pub fn brush_sketch(
 ) -> Result<BrushOutput> {
     let (spines, warnings, notes) = prepared_spines(sketch, opts)?;
     let refine = match &opts.refine {
-        Some(path) => Some(crate::io::load_svg(path)?),
+        Some(path) => Some(crate::read::svg::load_svg(path)?),
         None => None,
     };
     let trace = TraceOptions::default();

@@ -22,9 +22,9 @@ use super::query::{QueryOptions, QuerySpine};
 use super::ribs::{exemplar_features, resample_ribs};
 pub use super::ribs::{exemplar_width, WIDTH_PERCENTILE};
 use super::synth::{self, Coord, Field, SynthOptions};
+use crate::brush::analysis::BrushStyle;
 use crate::error::{Error, Result};
 use crate::raster::Grid;
-use crate::style::brush::BrushStyle;
 use kurbo::{Affine, Point, Vec2};
 
 /// Everything the pipeline can be told.

@@ -14,7 +14,7 @@
 //! by widening the spacing, so a huge path cannot blow up either.
 
 use crate::error::{Error, Result};
-use crate::sketch::{QueryKind, Sketch};
+use crate::read::sketch::{QueryKind, Sketch};
 use kurbo::{BezPath, PathEl, Point, Rect, Vec2};
 
 /// How query paths are resampled.
@@ -393,7 +393,7 @@ mod tests {
         let svg = format!(
             r##"<svg xmlns="http://www.w3.org/2000/svg" width="200" height="200" viewBox="0 0 200 200">{body}</svg>"##
         );
-        crate::sketch::parse(Path::new("s.svg"), svg.as_bytes()).expect("parses")
+        crate::read::sketch::parse(Path::new("s.svg"), svg.as_bytes()).expect("parses")
     }
 
     #[test]
@@ -521,7 +521,7 @@ mod tests {
             let x = i as f64 * 0.002;
             spine.line_to((x, 100.0 + 20.0 * (x * 0.3).sin()));
         }
-        s.queries.push(crate::sketch::Query {
+        s.queries.push(crate::read::sketch::Query {
             id: "long".into(),
             style: None,
             kind: QueryKind::Path { spine, width: 2.0 },

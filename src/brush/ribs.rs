@@ -6,9 +6,9 @@
 
 use super::matching::{SampleFeature, SpineFeatures};
 use super::query;
+use crate::brush::analysis::BrushStyle;
 use crate::error::{Error, Result};
 use crate::raster::Grid;
-use crate::style::brush::BrushStyle;
 use kurbo::Point;
 
 /// Percentile of the style's rib widths taken as "the exemplar width".

@@ -6,7 +6,7 @@
 //! * **Correction** (§5.4.2). A pixel's query neighbourhood is read from the
 //!   *appearance* of the current field (each pixel shows the exemplar's ink
 //!   SDF at its μ), on the rotated lattice of
-//!   [`crate::synth::neighbourhood`] with its up axis along the query
+//!   [`crate::brush::analysis::neighbourhood`] with its up axis along the query
 //!   orientation ω^q. Candidates are the pixel's own μ and the eight
 //!   coherent ones: neighbour n's coordinate continued to p,
 //!   `μ(n) + J(n) (p − n)` ([`jacobian`]). A candidate's distance is the
@@ -30,11 +30,11 @@
 //!   coherent neighbour; inside a patch `J` is the field's measured
 //!   Jacobian, so a warped segment is continued as the warp it is.
 
-use crate::pattern::rng;
+use crate::brush::analysis::neighbourhood::{Neighbourhood, SIZE};
+use crate::brush::analysis::{BrushStyle, ExemplarLevel};
 use crate::raster::Grid;
-use crate::style::brush::{BrushStyle, ExemplarLevel};
+use crate::rng;
 use crate::svg_out::Color;
-use crate::synth::neighbourhood::{Neighbourhood, SIZE};
 use rayon::prelude::*;
 
 /// One exemplar coordinate: exemplar index and a pixel-space position in

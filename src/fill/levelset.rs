@@ -19,8 +19,8 @@
 //! zero level (sub-pixel contours, exact distances), which restores
 //! `|∇Φ| = 1` for the next E-step and the next band.
 
+use crate::raster::contour;
 use crate::raster::{Grid, Sdf};
-use crate::trace::contour;
 use kurbo::{Affine, Line};
 use rayon::prelude::*;
 

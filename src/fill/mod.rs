@@ -45,8 +45,8 @@ pub mod tile;
 use crate::error::{Error, Result};
 use crate::field::diffusion::constant_field;
 use crate::raster::{Grid, Sdf};
-use crate::sketch::{self, QueryKind, Sketch};
-use crate::style::{self, DirectionToml, StyleKind};
+use crate::read::sketch::{self, QueryKind, Sketch};
+use crate::read::style::{self, DirectionToml, StyleKind};
 use crate::svg_out::{decimals_for, Document, FillRule, Group, Shape};
 use crate::trace::{trace_sdf, TraceOptions};
 use em::EmParams;
@@ -324,7 +324,7 @@ pub fn fill_sketch(opts: &FillOptions, sk: &Sketch) -> Result<FillOutput> {
             region.height(),
             region.area
         ));
-        let seed = crate::pattern::rng::hash(&[opts.seed, qi as u64]);
+        let seed = crate::rng::hash(&[opts.seed, qi as u64]);
         let syn = prepared.synthesize(&region.direction, Some(&region.mask), seed);
         let mut layers = syn.layers;
         // Occlusion order: each layer extends under the layers above it.

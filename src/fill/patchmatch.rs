@@ -18,8 +18,8 @@
 //! result does not depend on the number of threads.
 
 use super::shape::{self, Histogram};
-use crate::pattern::rng;
 use crate::raster::Grid;
+use crate::rng;
 use rayon::prelude::*;
 use std::borrow::Cow;
 

@@ -10,8 +10,8 @@
 //! other, moving at most one pixel sideways per row).
 
 use super::patchmatch::{angle_bin, Channels, ANGLE_BINS};
-use crate::pattern::rng;
 use crate::raster::Grid;
+use crate::rng;
 use rayon::prelude::*;
 
 /// Quilting parameters, pixels.

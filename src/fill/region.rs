@@ -5,7 +5,7 @@ use crate::error::{Error, Result};
 use crate::field::diffusion::{self, StrokeSample};
 use crate::field::DirectionGrid;
 use crate::io;
-use crate::raster::input::flatten_segments;
+use crate::raster::vector::flatten_segments;
 use crate::raster::{Grid, Sdf};
 use crate::svg_out::FillRule;
 use kurbo::{Affine, BezPath, Line, Point, Shape as _};

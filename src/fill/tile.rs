@@ -9,8 +9,8 @@
 
 use crate::error::{Error, Result};
 use crate::field::{edge_tangent_flow, DirectionGrid, EtfOptions};
-use crate::raster::input::{self, InputOptions};
 use crate::raster::{Grid, Sdf};
+use crate::read::ink::{self, InputOptions};
 use crate::svg_out::Color;
 use kurbo::{Affine, Vec2};
 use std::path::Path;
@@ -127,7 +127,7 @@ impl Tile {
     /// Loads a tile (SVG or PNG) at `resolution` px on its longest side
     /// (SVG; raster tiles keep their size). Fails when it holds no ink.
     pub fn load(path: &Path, resolution: u32, dir: SourceDirection) -> Result<Tile> {
-        let ink = input::load(
+        let ink = ink::load(
             path,
             &InputOptions {
                 resolution,

@@ -12,8 +12,8 @@
 //! so its maximum over P is reached at a corner).
 
 use crate::error::{Error, Result};
-use crate::sketch::{affine_of, paint_color, to_bezpath};
-use crate::style::FitPoints;
+use crate::read::style::FitPoints;
+use crate::read::svg::{affine_of, paint_color, to_bezpath};
 use crate::svg_out::{Color, FillRule, LineCap, LineJoin, Shape, Stroke};
 use kurbo::{Affine, BezPath, ParamCurve, ParamCurveArclen, Point, Shape as _, Vec2};
 use resvg::usvg;
@@ -212,7 +212,7 @@ pub fn load_example(
     fit: FitPoints,
     scale: f64,
 ) -> Result<Vec<ExampleStroke>> {
-    let tree = crate::io::parse_svg(path, data)?;
+    let tree = crate::read::svg::parse_svg(path, data)?;
     let h = (scale / 16.0).max(1e-3);
     let mut strokes = Vec::new();
     collect(tree.root(), fit, h, &mut strokes);

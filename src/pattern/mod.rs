@@ -21,13 +21,12 @@
 pub mod cluster;
 pub mod distribution;
 pub mod element;
-pub mod rng;
 pub mod seeds;
 pub mod synth;
 
 use crate::error::{Error, Result};
-use crate::sketch::{QueryKind, Sketch};
-use crate::style::{self, FitPoints, StyleKind};
+use crate::read::sketch::{QueryKind, Sketch};
+use crate::read::style::{self, FitPoints, StyleKind};
 use crate::svg_out::{Document, Group, Shape};
 use distribution::{Dim, Distribution, Graph};
 use element::{Element, ExampleStroke};
@@ -303,7 +302,7 @@ impl PatternOutput {
 /// Runs `flourish pattern` on the sketch file: loads the sketch and its
 /// styles, synthesizes, and returns the output document.
 pub fn run(opts: &PatternOptions, sketch: &Path) -> Result<Document> {
-    let sk = crate::sketch::load(sketch)?;
+    let sk = crate::read::sketch::load(sketch)?;
     Ok(synthesize_sketch(opts, &sk)?.to_document())
 }
 
@@ -478,14 +477,26 @@ fn fill(
     let n = (expected.round() as usize).max(1);
     let squeeze = r.dist.spacing / r.dist.pitch;
     let mut points: Vec<Point> = if (squeeze - 1.0).abs() < 1e-9 {
-        seeds::lloyd(region, n, rng::hash(key), style.params.lloyd_iterations).points
+        seeds::lloyd(
+            region,
+            n,
+            crate::rng::hash(key),
+            style.params.lloyd_iterations,
+        )
+        .points
     } else {
         let squeezed = Region::new(
             &(Affine::scale_non_uniform(1.0, squeeze) * outline.clone()),
             region.rule,
             0.05,
         )?;
-        seeds::lloyd(&squeezed, n, rng::hash(key), style.params.lloyd_iterations).points
+        seeds::lloyd(
+            &squeezed,
+            n,
+            crate::rng::hash(key),
+            style.params.lloyd_iterations,
+        )
+        .points
     };
     for p in &mut points {
         p.y /= squeeze;

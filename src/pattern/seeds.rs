@@ -20,7 +20,7 @@
 //! (1-D Lloyd converges in O(N²) sweeps towards the same answer).
 
 use super::distribution::{polygon_area, Indexed};
-use super::rng;
+use crate::rng;
 use crate::svg_out::FillRule;
 use kurbo::{BezPath, PathEl, Point, Rect, Vec2};
 use rayon::prelude::*;

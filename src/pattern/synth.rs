@@ -33,7 +33,7 @@
 
 use super::distribution::{surrounded, Dim, Distribution, Graph};
 use super::element::{directed_hausdorff, Element};
-use super::rng;
+use crate::rng;
 use kurbo::{Point, Vec2};
 use std::f64::consts::PI;
 

@@ -2,21 +2,13 @@
 //! signed distance field [`Sdf`] (the seam between every raster mode and the
 //! tracer), and loading of raster and SVG inputs as ink coverage.
 
-pub mod binary;
-pub mod corridor;
-pub mod cull;
-mod decode;
+pub mod bitmap;
+pub mod contour;
 pub mod edt;
-pub mod input;
-pub mod lighting;
-mod line_ends;
-pub mod paths;
 pub mod plain;
-mod polygon;
 pub mod scan;
 pub mod sdf;
-mod tips;
-mod vertices;
+pub mod vector;
 
 pub use sdf::Sdf;
 
@@ -138,3 +130,9 @@ impl Grid<f32> {
 /// Ink coverage of one layer: 0 (paper) to 1 (ink) per pixel, anti-aliased
 /// edges kept as fractional coverage.
 pub type Coverage = Grid<f32>;
+
+/// True when every coverage value is exactly 0 or 1: a binary bitmap,
+/// whose edge lies anywhere within half a pixel of its staircase.
+pub fn is_binary(cov: &Coverage) -> bool {
+    cov.data().iter().all(|&c| c == 0.0 || c == 1.0)
+}

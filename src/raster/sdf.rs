@@ -23,7 +23,7 @@
 
 use super::edt::{squared_edt, FAR};
 use super::{Coverage, Grid};
-use crate::trace::contour::{self, clamp_t, Link};
+use crate::raster::contour::{self, clamp_t, Link};
 use kurbo::{Affine, Line, Point, Vec2};
 use rayon::prelude::*;
 

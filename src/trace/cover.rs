@@ -18,9 +18,9 @@
 //! 2003, §2.4). Consecutive cubics meet with G1 continuity: both take the
 //! outline's tangent at the join.
 
-use super::fit::{corner_runs, Guide, Piece};
+use super::piece::{corner_runs, Guide, Piece};
 use super::span::{append_loop, fit_span, line_cubic, longest_span, CHORD_SHARE, MIN_SPAN_PX};
-use crate::raster::corridor::Corridor;
+use crate::outline::corridor::Corridor;
 use kurbo::{BezPath, CubicBez, Point, Vec2};
 use rayon::prelude::*;
 
@@ -48,7 +48,7 @@ const SEARCH_SHARE: f64 = 0.1875;
 /// the outline's unit tangents at its points and `corners` the indices
 /// (ascending) where it turns sharply, where cubics meet at an angle. This
 /// is the path for outlines known exactly (a binary bitmap's, see
-/// [`crate::raster::binary::SmoothLoop`]), with no SDF in between.
+/// [`crate::outline::smooth::SmoothLoop`]), with no SDF in between.
 pub fn fit_outline(
     pts: &[Point],
     tangents: &[Vec2],
@@ -108,9 +108,10 @@ fn turning(piece: &Piece) -> Vec<f64> {
         if piece.arc_at(i) - piece.arc_at(anchor) >= TURN_STEP || i == n - 1 {
             let d = (piece.point(i) - piece.point(anchor)).atan2();
             if let Some(p) = prev_dir {
-                let t =
-                    super::contour::wrap_once(d - p + std::f64::consts::PI, std::f64::consts::TAU)
-                        - std::f64::consts::PI;
+                let t = crate::raster::contour::wrap_once(
+                    d - p + std::f64::consts::PI,
+                    std::f64::consts::TAU,
+                ) - std::f64::consts::PI;
                 total += t.abs();
             }
             prev_dir = Some(d);

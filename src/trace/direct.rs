@@ -19,9 +19,8 @@
 //! outline (`Piece::holds`), which is all the fitter is held to, so no
 //! separate error measure along normals is needed.
 
-use super::fit::Piece;
 use super::nearest::nearest_from;
-use super::span::FIT_SAMPLES;
+use super::piece::{Piece, FIT_SAMPLES};
 use kurbo::common::{factor_quartic_inner, solve_cubic, solve_quadratic};
 use kurbo::{CubicBez, ParamCurve, Point, Vec2};
 
@@ -432,7 +431,7 @@ fn outline_to_curve(curve: &CurvePoints, samples: &[(Point, Vec2)], limit: f64) 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::trace::fit::Guide;
+    use crate::trace::piece::Guide;
 
     /// A piece along `f(t)`, t in 0..1, at `n` + 1 points, with the exact
     /// tangents `df`.

@@ -10,23 +10,21 @@
 //! DecoBrush (§7, "Vectorization from SDF") left this step to Illustrator;
 //! flourish measures it against potrace (`make bench`).
 
-pub mod contour;
-pub mod corner;
 pub mod cover;
 mod direct;
 pub mod fit;
 mod nearest;
-mod sample;
+mod piece;
 mod span;
 
 use crate::error::{Error, Result};
-use crate::raster::binary::{self, SmoothLoop};
-use crate::raster::corridor::Corridor;
-use crate::raster::input::{self, Ink, InputOptions, LayerOutline, Traceable};
-use crate::raster::paths::{self, Bitmap};
+use crate::outline::corridor::Corridor;
+use crate::outline::paths::{self, Bitmap};
+use crate::outline::smooth::{self, SmoothLoop};
+use crate::raster::contour::{self, contains, Contour};
 use crate::raster::Sdf;
+use crate::read::ink::{self, Ink, InputOptions, LayerOutline, Traceable};
 use crate::svg_out::{decimals_for, Color, Document, FillRule, Group, Shape};
-use contour::{contains, Contour};
 use kurbo::{BezPath, Point, Rect};
 use rayon::prelude::*;
 use std::path::Path;
@@ -173,7 +171,7 @@ pub fn trace_sdf(sdf: &Sdf, opts: &TraceOptions) -> Vec<BezPath> {
         .collect()
 }
 
-/// Traces a bitmap's outline (see [`crate::raster::binary`]) directly: one
+/// Traces a bitmap's outline (see [`crate::outline::smooth`]) directly: one
 /// closed Bézier path per island, in pixel units, with no SDF and no second
 /// contour extraction in between. The curves stay within `opts.tolerance`
 /// of the outline itself, or, given a binary bitmap's `corridor`, within
@@ -219,7 +217,7 @@ pub fn trace_outline(
 }
 
 /// Traces a binary bitmap's ink: what [`trace_outline`] makes of its
-/// smoothed loops ([`crate::raster::binary::bitmap_loops`]) and its
+/// smoothed loops ([`crate::outline::smooth::bitmap_loops`]) and its
 /// [`Corridor`], path by path. Each path is smoothed and fitted in one
 /// task, started as soon as the path is found (the walk round the pixel
 /// edges is sequential; the other threads fit what it has found so far),
@@ -232,7 +230,7 @@ pub fn trace_bitmap(bits: &Bitmap, opts: &TraceOptions) -> Vec<BezPath> {
     let corridor = Corridor::from_bitmap(bits);
     let fit = |p: &[Point]| {
         let mut path = BezPath::new();
-        let l = binary::smooth_loop(p);
+        let l = smooth::smooth_loop(p);
         if l.points.len() >= 3 {
             cover::fit_outline(
                 &l.points,
@@ -343,7 +341,7 @@ fn layer_group(i: usize, paths: Vec<BezPath>, color: Color) -> Option<Group> {
 /// ([`trace_outline`]); an SVG's from their SDFs.
 pub fn trace_file(path: &Path, input: &InputOptions, opts: &TraceOptions) -> Result<Document> {
     opts.validate()?;
-    match input::load_traceable(path, input)? {
+    match ink::load_traceable(path, input)? {
         Traceable::Field(ink) => trace_ink(&ink, opts),
         Traceable::Outline(o) => {
             let mut doc = Document::new(o.width, o.height, decimals_for(opts.tolerance));

@@ -4,7 +4,7 @@
 //! cubic for one span ([`fit_span`]: the piece's fitter and its checks, or
 //! a straight chord), and the cubics of a loop gathered into a path.
 
-use super::fit::{Guide, Piece};
+use super::piece::{Guide, Piece, FIT_SAMPLES};
 use kurbo::{Affine, BezPath, CubicBez, ParamCurve, ParamCurveArclen, Point, Vec2};
 use std::ops::Range;
 
@@ -282,7 +282,7 @@ pub(super) const MIN_SPAN_PX: f64 = 1.5;
 
 /// One cubic for `range` of the piece that passes the piece's checks: for
 /// an exact outline the direct fit ([`super::direct`]); for an SDF contour
-/// kurbo's fitter, with the curve also within `accuracy` + [`CHECK_SLACK`](super::fit::CHECK_SLACK)
+/// kurbo's fitter, with the curve also within `accuracy` + [`CHECK_SLACK`](super::piece::CHECK_SLACK)
 /// of the SDF's zero level at 63 points. Either way the curve may not loop
 /// away (arc length at most 1.5× the source's) and the range must not be
 /// "spicy" (see [`is_sharp`]).
@@ -301,10 +301,6 @@ fn fit_checked(piece: &Piece, range: Range<f64>, accuracy: f64) -> Option<CubicB
         && piece.keeps_handles_on_canvas(&c);
     ok.then_some(c)
 }
-
-/// Number of samples (ends included) a range is checked at: kurbo's error
-/// measure samples 20 interior points, so does [`super::direct`].
-pub(super) const FIT_SAMPLES: usize = 22;
 
 /// True when kurbo would judge a range "spicy" for these tangents of
 /// neighbouring error samples (more than about 11° apart) and fall back to measuring

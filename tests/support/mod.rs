@@ -24,7 +24,8 @@
 
 #![allow(dead_code)]
 
-use flourish::raster::input::{flatten_segments, to_kurbo};
+use flourish::raster::vector::flatten_segments;
+use flourish::read::svg::to_bezpath as to_kurbo;
 use flourish::svg_out::{count_segments, Document};
 use flourish::trace::TraceOptions;
 use kurbo::{BezPath, Line, PathEl, Point, Rect, Vec2};
@@ -163,7 +164,7 @@ fn collect(group: &usvg::Group, out: &mut Vec<FlatShape>) {
 
 /// The size of an SVG in user units (= px of its sample PNG).
 pub fn svg_size(svg_path: &Path) -> (f64, f64) {
-    let tree = flourish::io::load_svg(svg_path).expect("ground-truth SVG");
+    let tree = flourish::read::svg::load_svg(svg_path).expect("ground-truth SVG");
     (tree.size().width() as f64, tree.size().height() as f64)
 }
 
@@ -171,7 +172,7 @@ pub fn svg_size(svg_path: &Path) -> (f64, f64) {
 /// coordinates of its rendered PNG; see the module docs.
 pub fn ground_truth(svg_path: &Path) -> Vec<Line> {
     use rayon::prelude::*;
-    let tree = flourish::io::load_svg(svg_path).expect("ground-truth SVG");
+    let tree = flourish::read::svg::load_svg(svg_path).expect("ground-truth SVG");
     let mut shapes = Vec::new();
     collect(tree.root(), &mut shapes);
     let inside = |p: Point| shapes.iter().any(|s| s.contains(p));
@@ -545,7 +546,7 @@ pub fn run_potrace(bitmap: &image::GrayImage, runs: usize) -> (Vec<BezPath>, usi
         times.push(t.elapsed());
         assert!(st.success(), "potrace failed: {st}");
     }
-    let tree = flourish::io::load_svg(&svg).expect("potrace SVG");
+    let tree = flourish::read::svg::load_svg(&svg).expect("potrace SVG");
     // potrace writes width/height in pt; map the tree's size onto the bitmap.
     let scale = (
         bitmap.width() as f64 / tree.size().width() as f64,

@@ -1,4 +1,4 @@
-//! Steps 2–3 of [`crate::raster::binary`]: the straight runs of a closed
+//! Steps 2–3 of [`crate::outline::smooth`]: the straight runs of a closed
 //! path and the optimal polygon over them (Selinger 2003, §2.2).
 //!
 //! **Straight runs** (§2.2.1, the submodule `runs`). potrace calls a path
@@ -54,10 +54,12 @@ mod reference;
 
 pub(super) use runs::straight_runs;
 
-#[cfg(doc)]
-use super::binary::STRAIGHT_TOLERANCE;
 use kurbo::Point;
 use std::ops::{Add, Mul, Sub};
+
+/// How far (px) a straight run may pass from the path vertices it replaces.
+/// Half a pixel: the whole uncertainty of a binary edge.
+pub const STRAIGHT_TOLERANCE: f64 = 0.5;
 
 /// Longest straight run considered, in path vertices (about 50–70 px of
 /// outline). The penalty search's work grows with the runs' lengths.
@@ -496,9 +498,9 @@ fn best_start(
 mod tests {
     use super::reference::{self, Sums};
     use super::*;
-    use crate::raster::binary::smooth_outline;
+    use crate::outline::smooth::smooth_outline;
+    use crate::raster::contour;
     use crate::raster::Grid;
-    use crate::trace::contour;
 
     /// Every polygon round `n` vertices containing `start` (exhaustively,
     /// over vertex subsets) whose segments are possible under `ahead`:
@@ -738,10 +740,7 @@ mod tests {
             let d = path[(i + m) % n] - path[i];
             for k in 0..=m {
                 let off = d.cross(path[(i + k) % n] - path[i]).abs() / (d.x.abs() + d.y.abs());
-                assert!(
-                    off <= crate::raster::binary::STRAIGHT_TOLERANCE + 1e-9,
-                    "run {i}+{m}: {off}"
-                );
+                assert!(off <= STRAIGHT_TOLERANCE + 1e-9, "run {i}+{m}: {off}");
             }
         }
         // The polygon needs far fewer vertices than the path.

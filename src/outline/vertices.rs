@@ -1,4 +1,4 @@
-//! Step 4 of [`crate::raster::binary`]: the optimal polygon's vertices
+//! Step 4 of [`crate::outline::smooth`]: the optimal polygon's vertices
 //! moved off the path (Selinger 2003, §2.3.1). Each polygon edge gets the
 //! least-squares line of the path vertices it replaces; each vertex moves
 //! to the point of the box of half-side ½ round its path vertex nearest

@@ -3,7 +3,7 @@
 //! diagnostics sheet (each exemplar with its stroke region, ribs,
 //! orientation field and spine coloured from start, red, to end, green).
 
-use super::brush::{BrushStyle, Exemplar, SpineSource};
+use super::style::{BrushStyle, Exemplar, SpineSource};
 use crate::error::{Error, Result};
 use crate::raster::Grid;
 use crate::svg_out::Color;

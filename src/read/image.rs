@@ -1,16 +1,15 @@
-//! Raster files (PNG, JPEG, …) to ink coverage, for [`super::input`]:
+//! Raster files (PNG, JPEG, …) to ink coverage, for [`super::ink`]:
 //! decoding with the canvas limits checked first, coverage as alpha or
 //! darkness, binary bitmaps recognised (and kept as their ink
 //! [`Bitmap`]), or colours quantized into layers.
 
-use super::input::{Ink, InkLayer, InputOptions};
 use super::lighting::Lighting;
-use super::paths::Bitmap;
-use super::{Coverage, Grid, Sdf};
+use super::InputOptions;
 use crate::error::{Error, Result};
 use crate::io;
+use crate::outline::paths::Bitmap;
+use crate::raster::{Coverage, Grid};
 use crate::svg_out::Color;
-use kurbo::Affine;
 use rayon::prelude::*;
 use std::path::Path;
 
@@ -65,42 +64,6 @@ pub(super) enum RasterCoverage {
         h: usize,
         layers: Vec<(Color, Coverage)>,
     },
-}
-
-impl RasterCoverage {
-    /// Each layer's SDF: a binary layer's from its smooth outline, others
-    /// from their anti-aliased coverage; `to_user` maps pixels to the
-    /// input's units (the identity for raster files).
-    pub(super) fn into_ink(self, to_user: Affine) -> Ink {
-        let (w, h, layers) = match self {
-            RasterCoverage::Binary { w, h, color, bits } => (
-                w,
-                h,
-                vec![InkLayer {
-                    color,
-                    sdf: super::binary::bitmap_sdf(&bits, to_user),
-                }],
-            ),
-            RasterCoverage::Layers { w, h, layers } => (
-                w,
-                h,
-                layers
-                    .into_iter()
-                    .map(|(color, cov)| InkLayer {
-                        color,
-                        sdf: Sdf::from_coverage(&cov, to_user),
-                    })
-                    .collect(),
-            ),
-        };
-        Ink {
-            width: w as f64,
-            height: h as f64,
-            layers,
-            warnings: Vec::new(),
-            notes: Vec::new(),
-        }
-    }
 }
 
 /// Decodes raster bytes into ink coverage: alpha or darkness, one layer or
@@ -210,7 +173,7 @@ pub(super) fn pixel_coverage(
         // A binary bitmap stands for a smooth outline within half a pixel
         // of its staircase (see `binary`); anti-aliased coverage says where
         // the edge is.
-        if super::binary::is_binary(&cov) {
+        if crate::raster::is_binary(&cov) {
             let bits = Bitmap::from_coverage(&cov);
             RasterCoverage::Binary { w, h, color, bits }
         } else {
@@ -774,7 +737,7 @@ mod tests {
             let g = g as u8;
             Color::rgb(g, g, g)
         });
-        (super::super::binary::is_binary(&cov), color, cov)
+        (crate::raster::is_binary(&cov), color, cov)
     }
 
     proptest! {

@@ -1,5 +1,5 @@
 //! Apexes of an anti-aliased outline, sharpened (before the corners of
-//! [`super::binary::polygon_loop`] are found).
+//! [`super::smooth::polygon_loop`] are found).
 //!
 //! Where a thin stroke turns sharply (a mitred zigzag's apex, inside and
 //! out, a pointed leaf's tip), the pixels round the point are only partly
@@ -21,7 +21,7 @@
 //! holes sample's outline 1.35 → 0.51 px from its drawing (the star's and
 //! the triangle's points), IoU within ±0.001.
 
-use crate::trace::contour::wrap_once;
+use crate::raster::contour::wrap_once;
 use kurbo::{Point, Vec2};
 
 /// Longest stretch (px of arc) that may be replaced by a point: the cut
@@ -61,7 +61,7 @@ struct Arc<'a> {
 
 impl<'a> Arc<'a> {
     fn new(pts: &'a [Point]) -> Self {
-        let cum = crate::trace::contour::closed_arc_lengths(pts);
+        let cum = crate::raster::contour::closed_arc_lengths(pts);
         let total = cum.last().copied().unwrap_or(0.0);
         Arc { pts, cum, total }
     }

@@ -3,10 +3,10 @@
 //!
 //! * SVG through usvg: each distinct fill colour is a layer (stroked shapes
 //!   count as fills of their outline), the SDF is the exact distance to the
-//!   vector outline ([`crate::raster::input::svg_ink`]); a path with
+//!   vector outline ([`crate::read::ink::svg_ink`]); a path with
 //!   `id="spine"` is the hand-drawn main branch and is not ink.
 //! * Raster files through `image`: layers by quantized colour
-//!   ([`crate::raster::input::load_raster`]), resampled to each level's size
+//!   ([`crate::read::ink::load_raster`]), resampled to each level's size
 //!   by area averaging of their coverage, SDF with sub-pixel edges
 //!   ([`Sdf::from_coverage`]).
 //!
@@ -18,9 +18,9 @@
 
 use crate::error::{Error, Result};
 use crate::io;
-use crate::raster::input::{self, InputOptions};
 use crate::raster::plain::quantize_sdf;
 use crate::raster::{Coverage, Grid, Sdf};
+use crate::read::ink::{self, InputOptions};
 use crate::svg_out::Color;
 use kurbo::{Affine, BezPath, PathEl, Point};
 use resvg::usvg;
@@ -98,7 +98,7 @@ pub fn level_resolution(resolution: u32, level: usize) -> u32 {
 /// level, px on the longest side). Blank exemplars (no ink) are an error.
 pub fn load(path: &Path, resolution: u32) -> Result<ExemplarInk> {
     let bytes = io::read_file(path)?;
-    let ex = if input::looks_like_svg(&bytes) {
+    let ex = if ink::looks_like_svg(&bytes) {
         load_svg(path, &bytes, resolution)?
     } else {
         load_raster(path, &bytes, resolution)?
@@ -114,7 +114,7 @@ pub fn load(path: &Path, resolution: u32) -> Result<ExemplarInk> {
 }
 
 fn load_svg(path: &Path, bytes: &[u8], resolution: u32) -> Result<ExemplarInk> {
-    let tree = io::parse_svg(path, bytes)?;
+    let tree = crate::read::svg::parse_svg(path, bytes)?;
     let size = [tree.size().width() as f64, tree.size().height() as f64];
     let mut levels = Vec::with_capacity(LEVELS);
     for l in 0..LEVELS {
@@ -124,7 +124,7 @@ fn load_svg(path: &Path, bytes: &[u8], resolution: u32) -> Result<ExemplarInk> {
             invert: false,
             layers: true,
         };
-        let mut layered = input::svg_ink(path, &tree, &opts, Some(SPINE_ID))?;
+        let mut layered = ink::svg_ink(path, &tree, &opts, Some(SPINE_ID))?;
         for l in &mut layered.layers {
             quantize_sdf(&mut l.sdf.dist);
         }
@@ -165,7 +165,7 @@ fn find_spine(group: &usvg::Group) -> Option<BezPath> {
                 }
             }
             usvg::Node::Path(p) if p.id() == SPINE_ID => {
-                return Some(input::to_kurbo(p.data(), p.abs_transform()));
+                return Some(crate::read::svg::to_bezpath(p.data(), p.abs_transform()));
             }
             _ => {}
         }
@@ -192,7 +192,7 @@ fn polyline(path: &BezPath) -> Vec<Point> {
 }
 
 fn load_raster(path: &Path, bytes: &[u8], resolution: u32) -> Result<ExemplarInk> {
-    let native = input::load_raster(
+    let native = ink::load_raster(
         path,
         bytes,
         &InputOptions {

@@ -40,7 +40,7 @@ pub fn corners(pts: &[Point]) -> Vec<usize> {
     if n < 4 {
         return Vec::new();
     }
-    let cum = super::contour::closed_arc_lengths(pts);
+    let cum = crate::raster::contour::closed_arc_lengths(pts);
     let total = cum[n];
     if total < 4.0 * CORNER_WINDOW {
         return Vec::new();
@@ -50,7 +50,7 @@ pub fn corners(pts: &[Point]) -> Vec<usize> {
     // climb with the vertex, so each of the two reads keeps a cursor that
     // steps forwards (searching afresh only where the loop wraps).
     let at = |s: f64, cursor: &mut usize| -> Point {
-        let s = super::contour::wrap_once(s, total);
+        let s = crate::raster::contour::wrap_once(s, total);
         let mut i = *cursor;
         if cum[i] > s {
             i = cum[..n].partition_point(|&c| c <= s).saturating_sub(1);
@@ -84,14 +84,18 @@ pub fn corners(pts: &[Point]) -> Vec<usize> {
         // Local maximum within the window (ties broken by index).
         let mut is_max = true;
         let mut j = (i + 1) % n;
-        while j != i && super::contour::wrap_once(cum[j] - cum[i], total) < CORNER_SEPARATION {
+        while j != i
+            && crate::raster::contour::wrap_once(cum[j] - cum[i], total) < CORNER_SEPARATION
+        {
             if turn[j] > turn[i] {
                 is_max = false;
             }
             j = (j + 1) % n;
         }
         let mut j = (i + n - 1) % n;
-        while j != i && super::contour::wrap_once(cum[i] - cum[j], total) < CORNER_SEPARATION {
+        while j != i
+            && crate::raster::contour::wrap_once(cum[i] - cum[j], total) < CORNER_SEPARATION
+        {
             if turn[j] >= turn[i] {
                 is_max = false;
             }
@@ -106,7 +110,8 @@ pub fn corners(pts: &[Point]) -> Vec<usize> {
 
 #[cfg(test)]
 mod tests {
-    use crate::raster::{binary, sdf, Grid};
+    use crate::outline::smooth as binary;
+    use crate::raster::{sdf, Grid};
 
     /// The corners of the outline of an anti-aliased shape (coverage
     /// supersampled 16×16 per pixel) centred at (8, 8) + `offset`.

@@ -23,7 +23,7 @@
 //! mixed cell lies within the tolerance of it.
 
 use super::paths::Bitmap;
-use super::Coverage;
+use crate::raster::Coverage;
 use kurbo::Point;
 use std::borrow::Cow;
 

@@ -1,9 +1,9 @@
-//! Step 1 of [`crate::raster::binary`]: the closed paths around a binary
+//! Step 1 of [`crate::outline::smooth`]: the closed paths around a binary
 //! bitmap's ink, walked on the bits directly (potrace's path decomposition,
 //! Selinger 2003, §2.1, with flourish's vertices and orientation).
 //!
 //! A path runs through the midpoints of the pixel edges between ink and
-//! paper: exactly the loops of [`crate::trace::contour::extract`] on the
+//! paper: exactly the loops of [`crate::raster::contour::extract`] on the
 //! ±½ field of the bitmap (pixel centres as samples, a crossing halfway
 //! along every link, saddles joining the ink), in the same order, from the
 //! same first vertex and in the same direction, so the smoothing
@@ -13,115 +13,8 @@
 //! the four ink flags of each cell it enters, and the scan for first links
 //! skips runs of eight samples without a change of colour.
 
-use super::{Coverage, Grid};
+pub use crate::raster::bitmap::Bitmap;
 use kurbo::Point;
-use rayon::prelude::*;
-
-/// A binary bitmap's ink flags with a one-pixel border of paper, so a
-/// cell's four corners are plain lookups; rows of `width + 2` bytes.
-#[derive(Clone, Debug)]
-pub struct Bitmap {
-    width: usize,
-    height: usize,
-    /// `flags[(y + 1) * (width + 2) + x + 1]`: 1 when pixel (x, y) is ink.
-    flags: Vec<u8>,
-}
-
-impl Bitmap {
-    /// A `width` × `height` bitmap with ink where `ink(x, y)` (pixels).
-    pub fn from_fn(width: usize, height: usize, mut ink: impl FnMut(usize, usize) -> bool) -> Self {
-        let pw = width + 2;
-        let mut flags = vec![0u8; pw * (height + 2)];
-        for (y, row) in flags.chunks_mut(pw).skip(1).take(height).enumerate() {
-            for (x, f) in row.iter_mut().skip(1).take(width).enumerate() {
-                *f = u8::from(ink(x, y));
-            }
-        }
-        Bitmap {
-            width,
-            height,
-            flags,
-        }
-    }
-
-    /// The ink of coverage `cov`: pixels with coverage ≥ ½ (the rule of
-    /// [`crate::raster::binary`] and [`crate::raster::corridor`]).
-    pub fn from_coverage(cov: &Coverage) -> Self {
-        Self::from_rows(cov.width(), cov.height(), cov.data(), |&c| c >= 0.5)
-    }
-
-    /// A bitmap from `width`-long rows of `values` (row-major, at least
-    /// `width · height` of them; missing ones are paper), ink where
-    /// `ink(value)`. Rows are filled in parallel.
-    pub fn from_rows<T: Sync>(
-        width: usize,
-        height: usize,
-        values: &[T],
-        ink: impl Fn(&T) -> bool + Sync + Send,
-    ) -> Self {
-        let pw = width + 2;
-        let mut flags = vec![0u8; pw * (height + 2)];
-        if width > 0 {
-            let rows = values.par_chunks(width).take(height);
-            flags
-                .par_chunks_mut(pw)
-                .skip(1)
-                .zip(rows)
-                .for_each(|(out, row)| {
-                    for (f, v) in out.iter_mut().skip(1).zip(row) {
-                        *f = u8::from(ink(v));
-                    }
-                });
-        }
-        Bitmap {
-            width,
-            height,
-            flags,
-        }
-    }
-
-    /// Width in pixels.
-    pub fn width(&self) -> usize {
-        self.width
-    }
-
-    /// Height in pixels.
-    pub fn height(&self) -> usize {
-        self.height
-    }
-
-    /// Whether pixel (x, y) is ink; pixels outside the bitmap are paper.
-    pub fn ink(&self, x: isize, y: isize) -> bool {
-        let (w, h) = (self.width as isize, self.height as isize);
-        if x < -1 || y < -1 || x > w || y > h {
-            return false;
-        }
-        let i = (y + 1) as usize * (self.width + 2) + (x + 1) as usize;
-        self.flags.get(i).is_some_and(|&f| f != 0)
-    }
-
-    /// The padded flags, row by row (`width + 2` flags each, `height + 2`
-    /// rows; 1 for ink).
-    pub(crate) fn flags(&self) -> &[u8] {
-        &self.flags
-    }
-
-    /// The padded rows (`width + 2` flags each, `height + 2` of them).
-    pub(crate) fn padded_rows(&self) -> std::slice::Chunks<'_, u8> {
-        self.flags.chunks(self.width + 2)
-    }
-
-    /// As coverage: 1 for ink, 0 for paper.
-    pub fn to_coverage(&self) -> Coverage {
-        Grid::from_fn(self.width, self.height, |x, y| {
-            if self.ink(x as isize, y as isize) {
-                1.0
-            } else {
-                0.0
-            }
-        })
-    }
-}
 
 /// The signed area (px²) of the pixels a closed path bounds: the shoelace
 /// area of the path with each diagonal step's pixel corner put back (the
@@ -129,7 +22,7 @@ impl Bitmap {
 /// that is its pixel count, holes included (potrace's path area, which its
 /// speck threshold `turdsize` reads, Selinger 2003 §2.1); a hole's is
 /// minus its paper pixels. Outer paths are positive, as
-/// [`crate::trace::contour::signed_area`] has them.
+/// [`crate::raster::contour::signed_area`] has them.
 pub fn pixel_area(path: &[Point]) -> f64 {
     let n = path.len();
     let Some(&o) = path.first() else {
@@ -160,7 +53,7 @@ pub fn pixel_area(path: &[Point]) -> f64 {
 }
 
 /// A link between two 4-adjacent pixel centres (x, y) and (x + 1, y)
-/// (horizontal) or (x, y + 1) (vertical), as in [`crate::trace::contour`].
+/// (horizontal) or (x, y + 1) (vertical), as in [`crate::raster::contour`].
 #[derive(Clone, Copy, PartialEq, Eq)]
 struct Link {
     horizontal: bool,
@@ -219,7 +112,7 @@ const fn partner_table() -> [[u8; 4]; 16] {
 
 /// The closed paths around the ink of `bits` (see the module docs): outer
 /// boundaries with positive signed area
-/// ([`crate::trace::contour::signed_area`]), holes negative; vertices at
+/// ([`crate::raster::contour::signed_area`]), holes negative; vertices at
 /// the midpoints of pixel edges, in pixel coordinates.
 pub fn paths(bits: &Bitmap) -> Vec<Vec<Point>> {
     let mut out = Vec::new();
@@ -230,7 +123,7 @@ pub fn paths(bits: &Bitmap) -> Vec<Vec<Point>> {
 /// [`paths`], each handed to `found` as soon as it is walked (in the same
 /// order), so its processing can start while the walk goes on.
 pub fn for_each_path(bits: &Bitmap, mut found: impl FnMut(Vec<Point>)) {
-    let (w, h) = (bits.width, bits.height);
+    let (w, h) = (bits.width(), bits.height());
     if w == 0 || h == 0 {
         return;
     }
@@ -279,8 +172,8 @@ pub fn for_each_path(bits: &Bitmap, mut found: impl FnMut(Vec<Point>)) {
 /// cell's four corners is one lookup at `c`, `c + 1`, `c + pw + 1` and
 /// `c + pw` from its top-left corner's index `c`.
 fn walk(bits: &Bitmap, start: Link, seen: &mut [bool], cap: usize) -> Vec<Point> {
-    let pw = bits.width + 2;
-    let f = bits.flags.as_slice();
+    let pw = bits.width() + 2;
+    let f = bits.flags();
     // Padded index of pixel (x, y), x and y from −1; out of range reads as
     // paper (a crossed link never reaches there).
     let index = |x: i32, y: i32| (y + 1) as usize * pw + (x + 1) as usize;
@@ -327,7 +220,8 @@ fn walk(bits: &Bitmap, start: Link, seen: &mut [bool], cap: usize) -> Vec<Point>
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::trace::contour;
+    use crate::raster::contour;
+    use crate::raster::Grid;
     use proptest::prelude::*;
 
     /// A random `w` × `h` bitmap, ink with probability `density` per pixel

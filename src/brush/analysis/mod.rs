@@ -2,14 +2,14 @@
 //! [`BrushStyle::load`].
 //!
 //! For every exemplar (in parallel, results in `style.toml` order): the ink
-//! pyramid ([`super::exemplar`]), the spine — hand-drawn (`id="spine"`) or
+//! pyramid ([`exemplar`]), the spine — hand-drawn (`id="spine"`) or
 //! traced between `start` and `end` by Dijkstra over the edge tangent flow
-//! and a quartic fit ([`super::spine`]) —, ribs, per-sample features and
-//! per-pixel orientation ([`super::uv`]), and the oriented 5×5
+//! and a quartic fit ([`spine`]) —, ribs, per-sample features and
+//! per-pixel orientation ([`uv`]), and the oriented 5×5
 //! neighbourhoods of every stroke-region pixel on every level. Then, per
 //! level and over all exemplars, the neighbourhoods' PCA and search index
-//! ([`crate::synth::neighbourhood`]). The result is cached
-//! ([`super::cache`]).
+//! ([`crate::brush::analysis::neighbourhood`]). The result is cached
+//! ([`cache`]).
 //!
 //! Units: ribs, spines and features are in pixels of the **finest** level
 //! (`resolution` px on an exemplar's longest side); each [`ExemplarLevel`]
@@ -17,18 +17,25 @@
 //! [`Exemplar::ribs_at`] scales the ribs to a level. Pixel `(x, y)` of a grid
 //! has its centre at `(x + 0.5, y + 0.5)`.
 
-use super::cache::{self, CacheStatus};
-use super::exemplar::{self, InkLevel, LEVELS};
-use super::spine::{self, SpineOptions};
-use super::uv::{self, OrientationField, Ribs, SampleFeatures};
-use super::{StyleKind, StyleToml, STYLE_FILE};
+pub mod cache;
+pub mod check;
+pub mod exemplar;
+pub mod neighbourhood;
+pub mod spine;
+pub mod style;
+pub mod uv;
+
+pub use style::{region_refs, BrushStyle, Exemplar, ExemplarLevel, SpineSource};
+
+use self::cache::CacheStatus;
+use self::exemplar::LEVELS;
+use self::neighbourhood::{Neighbourhood, NeighbourhoodIndex, NeighbourhoodSampler, Pca, PCA_DIMS};
+use self::spine::SpineOptions;
 use crate::error::{Error, Result};
-use crate::synth::neighbourhood::{
-    Neighbourhood, NeighbourhoodIndex, NeighbourhoodRef, NeighbourhoodSampler, Pca, PCA_DIMS, SIZE,
-};
+use crate::read::style::{StyleKind, StyleToml, STYLE_FILE};
+
 use kurbo::Point;
 use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
 /// How a brush style is analysed and cached.
@@ -65,101 +72,6 @@ pub const REGION_MARGIN: f64 = 2.0;
 /// Default finest resolution of a brush style, px.
 pub const DEFAULT_RESOLUTION: u32 = 256;
 
-/// Where an exemplar's spine came from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub enum SpineSource {
-    /// A path with `id="spine"` in the exemplar.
-    Drawn,
-    /// Traced between `start` and `end` (Dijkstra + quartic).
-    Traced,
-}
-
-/// One exemplar at one pyramid level.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct ExemplarLevel {
-    /// This level's pixels per finest-level pixel (¼, ½ or 1).
-    pub scale: f64,
-    /// Ink: the layers with their colours and the all-ink SDF (px of this
-    /// level, negative inside).
-    pub ink: InkLevel,
-    /// Per-pixel stroking orientation and the stroke-region mask.
-    pub orientation: OrientationField,
-}
-
-impl ExemplarLevel {
-    /// Width in pixels.
-    pub fn width(&self) -> usize {
-        self.ink.ink.width()
-    }
-
-    /// Height in pixels.
-    pub fn height(&self) -> usize {
-        self.ink.ink.height()
-    }
-}
-
-/// One analysed exemplar.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct Exemplar {
-    /// The exemplar file, relative to the style folder.
-    pub file: PathBuf,
-    /// Width and height in the exemplar's user units.
-    pub size: [f64; 2],
-    /// How the spine was found.
-    pub spine_source: SpineSource,
-    /// The smooth spine as a dense polyline from start to end, finest px.
-    /// The ribs run along it extended straight beyond both ends over the
-    /// end ornaments ([`uv::extend_to_ink`]), by `extension` px.
-    pub spine: Vec<[f64; 2]>,
-    /// How far the ribs extend the spine beyond its start and its end,
-    /// finest px.
-    pub extension: [f64; 2],
-    /// The raw Dijkstra path (finest px) when the spine was traced.
-    pub path: Vec<[f64; 2]>,
-    /// Rib samples (30–100), finest px.
-    pub ribs: Ribs,
-    /// Per-sample features, parallel to the ribs.
-    pub features: Vec<SampleFeatures>,
-    /// The pyramid, coarse to fine.
-    pub levels: Vec<ExemplarLevel>,
-}
-
-impl Exemplar {
-    /// The finest level.
-    pub fn finest(&self) -> Option<&ExemplarLevel> {
-        self.levels.last()
-    }
-
-    /// The ribs in pixels of level `l` (0 = coarsest).
-    pub fn ribs_at(&self, l: usize) -> Ribs {
-        let s = self.levels.get(l).map(|lv| lv.scale).unwrap_or(1.0);
-        self.ribs.scaled(s)
-    }
-
-    /// Spine length along the rib samples, finest px.
-    pub fn spine_length(&self) -> f64 {
-        self.features.last().map(|f| f.from_start).unwrap_or(0.0)
-    }
-}
-
-/// An analysed brush style.
-#[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct BrushStyle {
-    /// The style's name (its folder's name).
-    pub name: String,
-    /// Finest resolution, px on an exemplar's longest side.
-    pub resolution: u32,
-    /// Synthesize signed distances (`true`) or coverage.
-    pub sdf: bool,
-    /// How neighbourhoods are read (use the same for query neighbourhoods).
-    pub sampler: NeighbourhoodSampler,
-    /// The exemplars in `style.toml` order.
-    pub exemplars: Vec<Exemplar>,
-    /// Per level (coarse to fine), the neighbourhoods of all exemplars'
-    /// stroke regions, searchable.
-    pub indexes: Vec<NeighbourhoodIndex>,
-}
-
 impl BrushStyle {
     /// Loads the brush style in folder `dir`: from the cache when it holds
     /// this content, else analysed (and cached).
@@ -176,7 +88,7 @@ impl BrushStyle {
         let toml_bytes = crate::io::read_file(&toml_path)?;
         let text = String::from_utf8(toml_bytes.clone())
             .map_err(|_| Error::invalid(&toml_path, "not UTF-8 text"))?;
-        let toml = super::parse(&toml_path, &text)?;
+        let toml = crate::read::style::parse(&toml_path, &text)?;
         toml.expect_kind(dir, StyleKind::Brush)?;
         if toml.exemplar.is_empty() {
             return Err(Error::invalid(
@@ -205,100 +117,6 @@ impl BrushStyle {
         }
         Ok((style, status))
     }
-
-    /// After decoding from the cache: the all-ink grids and the index
-    /// references, which are not stored twice; `false` when the decoded
-    /// data cannot provide them.
-    pub fn restore(&mut self) -> bool {
-        let inks = self
-            .exemplars
-            .iter_mut()
-            .flat_map(|e| e.levels.iter_mut())
-            .all(|l| l.ink.restore_ink());
-        let exemplars: Vec<&Exemplar> = self.exemplars.iter().collect();
-        let refs: Vec<Vec<NeighbourhoodRef>> = (0..self.indexes.len())
-            .map(|l| region_refs(&exemplars, l))
-            .collect();
-        for (idx, r) in self.indexes.iter_mut().zip(refs) {
-            idx.refs = r;
-        }
-        inks
-    }
-
-    /// Structural consistency (sizes agree everywhere, references in
-    /// range): what a cache file must pass before it is trusted.
-    pub fn validate(&self) -> bool {
-        let ok_ex = self.exemplars.iter().all(|e| {
-            let n = e.ribs.len();
-            e.levels.len() == LEVELS
-                && e.ribs.left.len() == n
-                && e.ribs.right.len() == n
-                && e.features.len() == n
-                && e.levels.iter().all(|l| {
-                    let (w, h) = (l.width(), l.height());
-                    let same = |g_w: usize, g_h: usize| g_w == w && g_h == h;
-                    l.scale.is_finite()
-                        && l.ink
-                            .layers
-                            .iter()
-                            .all(|ly| same(ly.sdf.width(), ly.sdf.height()))
-                        && same(l.orientation.dir.width(), l.orientation.dir.height())
-                        && same(l.orientation.mask.width(), l.orientation.mask.height())
-                })
-        });
-        let ok_idx = self.indexes.len() == LEVELS
-            && self.indexes.iter().enumerate().all(|(l, idx)| {
-                idx.points.len() == idx.refs.len()
-                    && idx.pca.mean.len() == SIZE
-                    && idx.pca.axes.len() == PCA_DIMS
-                    && idx.refs.iter().all(|r| {
-                        self.exemplars
-                            .get(r.exemplar as usize)
-                            .and_then(|e| e.levels.get(l))
-                            .is_some_and(|lv| {
-                                (r.x as usize) < lv.width() && (r.y as usize) < lv.height()
-                            })
-                    })
-            });
-        ok_ex && ok_idx && !self.exemplars.is_empty()
-    }
-
-    /// The neighbourhood of exemplar `r.exemplar` at pixel `(r.x, r.y)` of
-    /// level `level`, oriented along its per-pixel orientation.
-    pub fn neighbourhood(&self, level: usize, r: NeighbourhoodRef) -> Option<Neighbourhood> {
-        let lv = self.exemplars.get(r.exemplar as usize)?.levels.get(level)?;
-        let (x, y) = (r.x as usize, r.y as usize);
-        if x >= lv.width() || y >= lv.height() {
-            return None;
-        }
-        let up = lv.orientation.dir.get(x, y);
-        Some(
-            self.sampler
-                .sample(&lv.ink.ink, [x as f64 + 0.5, y as f64 + 0.5], up),
-        )
-    }
-}
-
-/// The pixels of every exemplar's stroke region at level `l`, exemplar by
-/// exemplar, row-major: the order of a level's [`NeighbourhoodIndex`].
-pub fn region_refs(exemplars: &[&Exemplar], l: usize) -> Vec<NeighbourhoodRef> {
-    let mut refs = Vec::new();
-    for (i, ex) in exemplars.iter().enumerate() {
-        let Some(lv) = ex.levels.get(l) else { continue };
-        let mask = &lv.orientation.mask;
-        for y in 0..mask.height() {
-            for x in 0..mask.width() {
-                if mask.get(x, y) {
-                    refs.push(NeighbourhoodRef {
-                        exemplar: i as u32,
-                        x: x as u32,
-                        y: y as u32,
-                    });
-                }
-            }
-        }
-    }
-    refs
 }
 
 fn style_name(dir: &Path) -> String {
@@ -363,7 +181,7 @@ fn analyse_exemplar(
     dir: &Path,
     toml_path: &Path,
     i: usize,
-    ex: &super::ExemplarToml,
+    ex: &crate::read::style::ExemplarToml,
     resolution: u32,
     sampler: &NeighbourhoodSampler,
     opts: &AnalysisOptions,

@@ -4,19 +4,12 @@
 //! style folder from a `--style` argument ([`resolve`]). Brush libraries are
 //! analysed here, stage by stage: [`exemplar`] (loading, pyramid, SDF
 //! layers), [`spine`] (main branch), [`uv`] (ribs and per-pixel
-//! orientation), the neighbourhood index ([`crate::synth::neighbourhood`]),
+//! orientation), the neighbourhood index ([`crate::brush::analysis::neighbourhood`]),
 //! [`cache`], and [`check`] (report and diagnostics sheet); [`brush`] ties
 //! them together ([`brush::BrushStyle::load`]). Pattern styles are analysed
 //! by `pattern::PatternStyle`.
 //!
 //! Every error names the `style.toml` file and, where there is one, the key.
-
-pub mod brush;
-pub mod cache;
-pub mod check;
-pub mod exemplar;
-pub mod spine;
-pub mod uv;
 
 use crate::error::{Error, Result};
 use serde::Deserialize;

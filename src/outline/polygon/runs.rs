@@ -1,4 +1,4 @@
-//! Step 2 of [`crate::raster::binary`]: the straight runs of a closed path
+//! Step 2 of [`crate::outline::smooth`]: the straight runs of a closed path
 //! (Selinger 2003, §2.2.1), on the half-pixel lattice.
 //!
 //! A run is anchored at its first vertex; a cone of admissible directions
@@ -24,7 +24,7 @@ use super::{Lattice, MAX_RUN};
 use kurbo::Point;
 use rayon::prelude::*;
 
-use crate::raster::binary::STRAIGHT_TOLERANCE;
+use super::STRAIGHT_TOLERANCE;
 
 /// [`STRAIGHT_TOLERANCE`] in doubled pixel coordinates: the boxes' corners
 /// are lattice points only while it is a multiple of ½ px (checked when
@@ -35,7 +35,7 @@ const _: () = assert!(TOL as f64 == 2.0 * STRAIGHT_TOLERANCE && TOL > 0);
 /// Step 2: `lon[i]` = how many vertices ahead of `i` a straight run from `i`
 /// reaches (at least 1, fewer than [`MAX_RUN`]).
 #[inline(never)] // (once per path; kept whole in profiles)
-pub(in crate::raster) fn straight_runs(path: &[Point]) -> Vec<usize> {
+pub(in crate::outline) fn straight_runs(path: &[Point]) -> Vec<usize> {
     let runs = Runs::new(path);
     if path.len() >= PARALLEL_RUNS {
         // A long loop (an ornament's outline holds most of its vertices)
@@ -283,8 +283,8 @@ const fn corner_offsets() -> [[i8; 4]; 9] {
 mod tests {
     use super::super::reference::{direction, run_from};
     use super::*;
+    use crate::raster::contour;
     use crate::raster::Grid;
-    use crate::trace::contour;
 
     /// The closed paths round the ink of `cov` (coverage ≥ ½).
     fn paths_of(cov: &Grid<f32>) -> Vec<Vec<Point>> {
@@ -313,7 +313,7 @@ mod tests {
             // A union of random discs and slanted bars, rasterized; the
             // later rounds larger, so long shallow staircases occur.
             let size = if round < 40 { 64 } else { 200 };
-            let cov = crate::raster::polygon::tests::random_blobs(size, 4, &mut rnd);
+            let cov = crate::outline::polygon::tests::random_blobs(size, 4, &mut rnd);
             for path in &paths_of(&cov) {
                 let fast = straight_runs(path);
                 for (i, &lon) in fast.iter().enumerate() {

@@ -1,5 +1,5 @@
 //! Thin-line ends of a binary bitmap's polygon, squared off (between steps 4
-//! and 5 of [`crate::raster::binary`]).
+//! and 5 of [`crate::outline::smooth`]).
 //!
 //! The path through pixel-edge midpoints chamfers the end of a line one or
 //! two pixels wide down to a single tip vertex half a pixel out. A straight
@@ -469,7 +469,7 @@ fn mitre(p: Point, q: Point, tip: Point, limit: f64) -> Vec<Point> {
 
 #[cfg(test)]
 mod tests {
-    use crate::raster::binary::smooth_loops;
+    use crate::outline::smooth::smooth_loops;
     use crate::raster::{Coverage, Grid};
     use kurbo::{Point, Rect};
 

@@ -18,10 +18,10 @@
 //!   analysed again and the file rewritten atomically. Failing to write the
 //!   cache (read-only folder) is not an error.
 
-use super::brush::{BrushStyle, Exemplar};
+use super::style::{BrushStyle, Exemplar};
+use crate::brush::analysis::neighbourhood::{NeighbourhoodIndex, NeighbourhoodSampler};
 use crate::error::Result;
 use crate::io;
-use crate::synth::neighbourhood::{NeighbourhoodIndex, NeighbourhoodSampler};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};

@@ -3,8 +3,8 @@
 //! walked vertex by vertex, the penalty from prefix sums about the start
 //! vertex). The fast code must agree with them exactly.
 
+use super::STRAIGHT_TOLERANCE;
 use super::{fewest_start, MAX_RUN};
-use crate::raster::binary::STRAIGHT_TOLERANCE;
 use kurbo::{Point, Vec2};
 
 /// Which of eight directions, 45° apart (0 along +x, counting towards

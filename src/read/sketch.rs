@@ -17,6 +17,7 @@
 
 use crate::error::{Error, Result};
 use crate::io;
+use crate::read::svg::{affine_of, to_bezpath};
 use crate::svg_out::FillRule;
 use kurbo::{Affine, BezPath, Rect, Shape as _};
 use resvg::usvg;
@@ -95,13 +96,13 @@ pub fn load(path: &Path) -> Result<Sketch> {
 
 /// Parses sketch SVG bytes; `path` names the file in errors.
 pub fn parse(path: &Path, data: &[u8]) -> Result<Sketch> {
-    let data = &*io::inflate_svgz(path, data)?;
+    let data = &*crate::read::svg::inflate_svgz(path, data)?;
     let text = std::str::from_utf8(data).map_err(|_| Error::Svg {
         path: path.to_path_buf(),
         reason: "not UTF-8 text".into(),
     })?;
     let pre = preprocess(path, text)?;
-    let tree = io::parse_svg(path, pre.text.as_bytes())?;
+    let tree = crate::read::svg::parse_svg(path, pre.text.as_bytes())?;
     let size = tree.size();
     let (width, height) = (size.width() as f64, size.height() as f64);
     let view_box = pre.view_box.unwrap_or(Rect::new(0.0, 0.0, width, height));
@@ -120,65 +121,8 @@ pub fn parse(path: &Path, data: &[u8]) -> Result<Sketch> {
     walk(tree.root(), to_user, &pre.styles, &mut sketch);
     sketch
         .warnings
-        .extend(io::text_left_out(data).map(String::from));
+        .extend(crate::read::svg::text_left_out(data).map(String::from));
     Ok(sketch)
-}
-
-/// Converts a tiny-skia path under transform `ts` into a kurbo path.
-pub fn to_bezpath(path: &usvg::tiny_skia_path::Path, ts: usvg::Transform) -> BezPath {
-    use usvg::tiny_skia_path::PathSegment;
-    let affine = affine_of(ts);
-    let p = |q: usvg::tiny_skia_path::Point| affine * kurbo::Point::new(q.x as f64, q.y as f64);
-    let mut out = BezPath::new();
-    for seg in path.segments() {
-        match seg {
-            PathSegment::MoveTo(a) => out.move_to(p(a)),
-            PathSegment::LineTo(a) => out.line_to(p(a)),
-            PathSegment::QuadTo(a, b) => out.quad_to(p(a), p(b)),
-            PathSegment::CubicTo(a, b, c) => out.curve_to(p(a), p(b), p(c)),
-            PathSegment::Close => out.close_path(),
-        }
-    }
-    out
-}
-
-/// The affine of a usvg transform.
-pub fn affine_of(ts: usvg::Transform) -> Affine {
-    Affine::new([
-        ts.sx as f64,
-        ts.ky as f64,
-        ts.kx as f64,
-        ts.sy as f64,
-        ts.tx as f64,
-        ts.ty as f64,
-    ])
-}
-
-/// Colour of a usvg paint: a flat colour as is, a gradient as the mean of
-/// its stops, a pattern as black.
-pub fn paint_color(paint: &usvg::Paint) -> crate::svg_out::Color {
-    use crate::svg_out::Color;
-    match paint {
-        usvg::Paint::Color(c) => Color::rgb(c.red, c.green, c.blue),
-        usvg::Paint::LinearGradient(g) => mean_stop(g.stops()),
-        usvg::Paint::RadialGradient(g) => mean_stop(g.stops()),
-        usvg::Paint::Pattern(_) => Color::BLACK,
-    }
-}
-
-fn mean_stop(stops: &[usvg::Stop]) -> crate::svg_out::Color {
-    if stops.is_empty() {
-        return crate::svg_out::Color::BLACK;
-    }
-    let n = stops.len() as f64;
-    let avg = |f: &dyn Fn(&usvg::Stop) -> u8| {
-        (stops.iter().map(|s| f(s) as f64).sum::<f64>() / n).round() as u8
-    };
-    crate::svg_out::Color::rgb(
-        avg(&|s| s.color().red),
-        avg(&|s| s.color().green),
-        avg(&|s| s.color().blue),
-    )
 }
 
 struct Preprocessed {

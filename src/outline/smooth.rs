@@ -57,17 +57,15 @@
 //! inside of pixel centres taken from the curves (not from the bitmap), so
 //! the sign and the distance agree.
 
-use crate::raster::paths::{self, Bitmap};
-use crate::raster::polygon::{optimal_polygon, possible_segments, straight_runs};
-use crate::raster::vertices::{adjust_vertices, edge_lines};
-use crate::raster::{line_ends, Coverage, Grid, Sdf};
-use crate::trace::contour;
+use super::line_ends;
+use crate::outline::paths::{self, Bitmap};
+pub use crate::outline::polygon::STRAIGHT_TOLERANCE;
+use crate::outline::polygon::{optimal_polygon, possible_segments, straight_runs};
+use crate::outline::vertices::{adjust_vertices, edge_lines};
+use crate::raster::contour;
+use crate::raster::{Coverage, Grid, Sdf};
 use kurbo::{CubicBez, ParamCurve, ParamCurveDeriv, Point, Vec2};
 use rayon::prelude::*;
-
-/// How far (px) a straight run may pass from the path vertices it replaces.
-/// Half a pixel: the whole uncertainty of a binary edge.
-pub const STRAIGHT_TOLERANCE: f64 = 0.5;
 
 /// Vertices with `α` at least this stay corners (potrace's default 1.0).
 pub const ALPHA_MAX: f64 = 1.0;
@@ -79,11 +77,6 @@ pub const ALPHA_MAX: f64 = 1.0;
 /// fewer instructions per trace, 3669 → 3634 segments, IoU 0.9742 →
 /// 0.9740, binary glyph deviation 0.97 → 1.03 px against potrace's 1.14).
 const FLATTEN: f64 = 0.1;
-
-/// True when every coverage value is exactly 0 or 1.
-pub fn is_binary(cov: &Coverage) -> bool {
-    cov.data().iter().all(|&c| c == 0.0 || c == 1.0)
-}
 
 /// One closed loop of a binary bitmap's smoothed outline, flattened: the
 /// points (pixel coordinates), the unit tangent of the smooth curve at each
@@ -109,7 +102,7 @@ pub struct SmoothLoop {
 /// The smoothed outline of binary coverage `cov` as [`SmoothLoop`]s with
 /// tangents and corners: what `flourish trace` fits Béziers to directly.
 /// Outer loops are counter-clockwise in the y-down sense of
-/// [`crate::trace::contour::Contour::signed_area`] > 0, holes the other way.
+/// [`crate::raster::contour::Contour::signed_area`] > 0, holes the other way.
 pub fn smooth_loops(cov: &Coverage) -> Vec<SmoothLoop> {
     bitmap_loops(&Bitmap::from_coverage(cov))
 }
@@ -125,7 +118,7 @@ pub fn bitmap_loops(bits: &Bitmap) -> Vec<SmoothLoop> {
 
 /// The smoothed outline of binary coverage `cov`: closed polylines in pixel
 /// coordinates (outer loops counter-clockwise in the y-down sense of
-/// [`crate::trace::contour::Contour::signed_area`] > 0, holes the other way).
+/// [`crate::raster::contour::Contour::signed_area`] > 0, holes the other way).
 pub fn smooth_outline(cov: &Coverage) -> Vec<Vec<Point>> {
     smooth_loops(cov).into_iter().map(|l| l.points).collect()
 }
@@ -407,11 +400,11 @@ fn corner_mask(l: &SmoothLoop) -> Vec<bool> {
 /// A closed polygon that follows an outline closely (an anti-aliased
 /// bitmap's sub-pixel outline) as a [`SmoothLoop`]: apexes that half
 /// coverage cut off given their points back (`super::tips`), corners where
-/// it turns sharply within a pixel or so ([`crate::trace::corner::corners`]),
+/// it turns sharply within a pixel or so ([`crate::outline::corner::corners`]),
 /// chord tangents elsewhere.
 pub fn polygon_loop(points: Vec<Point>) -> SmoothLoop {
     let points = super::tips::sharpen(points);
-    let corners = crate::trace::corner::corners(&points);
+    let corners = crate::outline::corner::corners(&points);
     let n = points.len();
     let tangents = (0..n)
         .map(|i| unit(points[(i + 1) % n] - points[i]))
@@ -551,7 +544,7 @@ pub fn inside(w: usize, h: usize, loops: &[Vec<Point>]) -> Grid<bool> {
     let edges = loops
         .iter()
         .flat_map(|poly| (0..poly.len()).map(move |i| (poly[i], poly[(i + 1) % poly.len()])));
-    super::scan::fill(&mut grid, edges, false);
+    crate::raster::scan::fill(&mut grid, edges, false);
     grid
 }
 
