@@ -43,25 +43,22 @@ demo:
 
 # The whole test suite (heavy tests run optimized: see [profile.test]).
 test: deps
-	$(CARGO) build --all-targets
+	$(CARGO) build --workspace --all-targets
 	$(CARGO) test --tests
 
 # Regenerate the golden files; review the diff before committing.
 golden:
-	UPDATE_GOLDEN=1 $(CARGO) test --test trace golden
-	UPDATE_GOLDEN=1 $(CARGO) test --test pattern
-	UPDATE_GOLDEN=1 $(CARGO) test --test fill golden
-	UPDATE_GOLDEN=1 $(CARGO) test --test brush golden
+	UPDATE_GOLDEN=1 $(CARGO) test --test golden
 	git status --short golden/
 
 # Criterion benchmarks of every pipeline, then the side-by-side with potrace.
 bench: deps
 	$(CARGO) bench
-	$(CARGO) run --release --example compare_potrace
+	$(CARGO) run --release -p flourish-tools --bin compare_potrace
 
 lint:
 	$(CARGO) fmt --all -- --check
-	$(CARGO) clippy --all-targets -- -D warnings
+	$(CARGO) clippy --workspace --all-targets -- -D warnings
 
 clean:
 	rm -rf $(OUT) golden/.failed

@@ -8,7 +8,7 @@
 //! Run: `cargo bench --bench style`.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use flourish::brush::analysis::{AnalysisOptions, BrushStyle};
+use flourish::{Style, StyleOptions};
 use std::hint::black_box;
 use std::path::PathBuf;
 
@@ -41,14 +41,14 @@ fn copy_without_spines(from: &std::path::Path, to: &std::path::Path) -> std::io:
 fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("style-analysis-512");
     g.sample_size(10);
-    let fresh = AnalysisOptions {
+    let fresh = StyleOptions {
         use_cache: false,
-        ..AnalysisOptions::default()
+        ..StyleOptions::default()
     };
     for name in ["vine", "scroll", "doodle"] {
         let d = dir(name);
         g.bench_with_input(BenchmarkId::from_parameter(name), &d, |b, d| {
-            b.iter(|| BrushStyle::load(black_box(d), &fresh).map(|s| s.exemplars.len()))
+            b.iter(|| Style::load(black_box(d), &fresh).map(|s| s.files().len()))
         });
     }
     // The same vine with its drawn spines removed: every spine traced by
@@ -62,7 +62,7 @@ fn bench(c: &mut Criterion) {
         panic!("{e}");
     }
     g.bench_with_input(BenchmarkId::from_parameter("vine-traced"), &tdir, |b, d| {
-        b.iter(|| BrushStyle::load(black_box(d), &fresh).map(|s| s.exemplars.len()))
+        b.iter(|| Style::load(black_box(d), &fresh).map(|s| s.files().len()))
     });
     g.finish();
 
@@ -72,18 +72,18 @@ fn bench(c: &mut Criterion) {
         Ok(t) => t,
         Err(e) => panic!("{e}"),
     };
-    let cached = AnalysisOptions {
+    let cached = StyleOptions {
         cache_dir: Some(cache.path().to_path_buf()),
-        ..AnalysisOptions::default()
+        ..StyleOptions::default()
     };
     for name in ["vine", "scroll", "doodle"] {
         let d = dir(name);
         // Fill the cache outside the timing.
-        if let Err(e) = BrushStyle::load(&d, &cached) {
+        if let Err(e) = Style::load(&d, &cached) {
             panic!("{e}");
         }
         g.bench_with_input(BenchmarkId::from_parameter(name), &d, |b, d| {
-            b.iter(|| BrushStyle::load(black_box(d), &cached).map(|s| s.exemplars.len()))
+            b.iter(|| Style::load(black_box(d), &cached).map(|s| s.files().len()))
         });
     }
     g.finish();

@@ -1,19 +1,20 @@
-//! Criterion benchmarks of the trace pipeline, stage by stage, on the
-//! project's own samples (a 512² glyph and the 2-megapixel ornament).
-//! Run with `make bench`; the potrace comparison is
-//! `cargo run --release --example compare_potrace`.
+//! Criterion benchmarks of `flourish trace` on the project's own samples
+//! (a 512² glyph, a scroll, the 2-megapixel ornament, binary and
+//! anti-aliased, and an SVG): the picture read from bytes and traced to
+//! SVG text, as the command does it after reading the file.
+//! Run with `make bench`; the side-by-side with potrace is
+//! `cargo run --release -p flourish-tools --bin compare_potrace`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use flourish::raster::contour;
-use flourish::read::ink::{load, InputOptions};
-use flourish::trace::{trace_file, trace_sdf, TraceOptions};
+use flourish::{Image, ImageOptions, TraceOptions};
 use std::hint::black_box;
 use std::path::PathBuf;
 
-fn sample(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+fn sample(name: &str) -> Vec<u8> {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("samples/trace")
-        .join(name)
+        .join(name);
+    std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
 fn bench_trace(c: &mut Criterion) {
@@ -26,22 +27,13 @@ fn bench_trace(c: &mut Criterion) {
         "ornament-2mp-aa.png",
         "ornament-scroll.svg",
     ] {
-        let path = sample(name);
-        let input = InputOptions::default();
-        let opts = TraceOptions::default();
-        g.bench_function(format!("{name}/load+sdf"), |b| {
-            b.iter(|| black_box(load(&path, &input).expect("loads")))
-        });
-        let ink = load(&path, &input).expect("loads");
-        let sdf = &ink.layers[0].sdf;
-        g.bench_function(format!("{name}/contours"), |b| {
-            b.iter(|| black_box(contour::extract(&sdf.dist)))
-        });
-        g.bench_function(format!("{name}/fit"), |b| {
-            b.iter(|| black_box(trace_sdf(sdf, &opts)))
-        });
-        g.bench_function(format!("{name}/total"), |b| {
-            b.iter(|| black_box(trace_file(&path, &input, &opts).expect("traces").to_svg()))
+        let bytes = sample(name);
+        let (input, opts) = (ImageOptions::default(), TraceOptions::default());
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                let image = Image::from_bytes(black_box(&bytes), &input).expect("reads");
+                flourish::trace(&image, &opts).expect("traces").to_svg()
+            })
         });
     }
     g.finish();

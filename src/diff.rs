@@ -21,7 +21,7 @@ pub struct DiffReport {
     /// Pixels compared.
     pub total: u64,
     /// Three panels side by side, expected | mask | actual, as RGBA rows.
-    pub panels: image::RgbaImage,
+    pub(crate) panels: image::RgbaImage,
 }
 
 impl DiffReport {
@@ -38,25 +38,23 @@ impl DiffReport {
 /// Renders both SVG texts at the same pixel size (the first one's, scaled to
 /// [`DIFF_SIDE`]) over white and compares them pixel by pixel.
 pub fn diff_svg_texts(a_name: &Path, a: &[u8], b_name: &Path, b: &[u8]) -> Result<DiffReport> {
-    let ta = crate::read::svg::parse_svg(a_name, a)?;
-    let tb = crate::read::svg::parse_svg(b_name, b)?;
+    let ta = crate::read::svg::parse_svg(a).map_err(|e| e.in_file(a_name))?;
+    let tb = crate::read::svg::parse_svg(b).map_err(|e| e.in_file(b_name))?;
     let (sa, sb) = (ta.size(), tb.size());
     if (sa.width() - sb.width()).abs() > 1e-3 || (sa.height() - sb.height()).abs() > 1e-3 {
-        return Err(Error::invalid(
-            b_name,
-            format!(
-                "size {}×{} differs from {} ({}×{})",
-                sb.width(),
-                sb.height(),
-                a_name.display(),
-                sa.width(),
-                sa.height()
-            ),
-        ));
+        return Err(Error::invalid(format!(
+            "size {}×{} differs from {} ({}×{})",
+            sb.width(),
+            sb.height(),
+            a_name.display(),
+            sa.width(),
+            sa.height()
+        ))
+        .in_file(b_name));
     }
     let white = Some([255, 255, 255, 255]);
-    let pa = render::render_tree(a_name, &ta, Some(DIFF_SIDE), white)?;
-    let pb = render::render_tree(b_name, &tb, Some(DIFF_SIDE), white)?;
+    let pa = render::render_tree(&ta, Some(DIFF_SIDE), white).map_err(|e| e.in_file(a_name))?;
+    let pb = render::render_tree(&tb, Some(DIFF_SIDE), white).map_err(|e| e.in_file(b_name))?;
     Ok(compare(&pa, &pb))
 }
 
@@ -100,12 +98,14 @@ fn compare(a: &Pixmap, b: &Pixmap) -> DiffReport {
     }
 }
 
-/// Writes the report's panels as a PNG, atomically.
-pub fn write_panels(report: &DiffReport, out: &Path) -> Result<()> {
-    let mut png = Vec::new();
-    report
-        .panels
-        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
-        .map_err(|e| Error::invalid(out, format!("PNG encoding failed: {e}")))?;
-    io::write_atomic(out, &png)
+impl DiffReport {
+    /// Three panels side by side, expected | mask (changed pixels red) |
+    /// actual, as PNG bytes.
+    pub fn panels_png(&self) -> Result<Vec<u8>> {
+        let mut png = Vec::new();
+        self.panels
+            .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+            .map_err(|e| Error::invalid(format!("PNG encoding failed: {e}")))?;
+        Ok(png)
+    }
 }

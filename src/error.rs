@@ -8,9 +8,13 @@ use std::path::PathBuf;
 /// Result alias used throughout the library.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
-/// Everything that can go wrong in flourish. Each variant renders as one
-/// line, `file: cause`, suitable for stderr.
+/// Everything that can go wrong in flourish. Each error renders as one
+/// line: the file it concerns (attached by whoever read the file, see
+/// [`Error::in_file`]), the part of the input (a query, an exemplar), and
+/// the cause, e.g. `sketch.svg: query q-1: 7672×7672 px exceeds the size
+/// limit (…)`.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum Error {
     /// Reading or writing a file failed.
     #[error("{}: {source}", shown(path))]
@@ -21,27 +25,33 @@ pub enum Error {
         #[source]
         source: std::io::Error,
     },
-    /// A raster file could not be decoded.
-    #[error("{}: not a readable image: {reason}", shown(path))]
-    Image {
+    /// Something is wrong in a file.
+    #[error("{}: {source}", shown(path))]
+    File {
         /// The file concerned.
         path: PathBuf,
-        /// The decoder's explanation.
-        reason: String,
+        /// What is wrong in it.
+        #[source]
+        source: Box<Error>,
     },
-    /// An SVG file could not be parsed.
-    #[error("{}: SVG does not parse: {reason}", shown(path))]
-    Svg {
-        /// The file concerned.
-        path: PathBuf,
-        /// The parser's explanation.
-        reason: String,
+    /// Something is wrong in one part of the input: a query, an exemplar.
+    #[error("{part}: {source}")]
+    Part {
+        /// The part, as the user knows it (e.g. `query q-1`).
+        part: String,
+        /// What is wrong with it.
+        #[source]
+        source: Box<Error>,
     },
-    /// An input or requested canvas exceeds the resource limits.
-    #[error("{}: {} exceeds the size limit ({limit})", shown(path), canvas_size(*width, *height))]
+    /// Raster bytes could not be decoded.
+    #[error("not a readable image: {0}")]
+    Image(String),
+    /// SVG bytes could not be parsed.
+    #[error("SVG does not parse: {0}")]
+    Svg(String),
+    /// An input or a canvas it asks for exceeds the resource limits.
+    #[error("{} exceeds the size limit ({limit})", canvas_size(*width, *height))]
     TooLarge {
-        /// The file concerned.
-        path: PathBuf,
         /// Requested width in pixels.
         width: u64,
         /// Requested height in pixels.
@@ -49,16 +59,12 @@ pub enum Error {
         /// The limit, in words (e.g. "16384 px per side, 64 Mpx in all").
         limit: String,
     },
-    /// The input is well-formed but cannot be used (degenerate, empty, NaN…).
-    #[error("{}: {reason}", shown(path))]
-    Invalid {
-        /// The file concerned.
-        path: PathBuf,
-        /// What is wrong with it.
-        reason: String,
-    },
-    /// A computation's input is degenerate and no file is concerned (a mesh
-    /// with zero-area triangles, a matching with no candidates…).
+    /// The input is well-formed but cannot be used (degenerate, empty,
+    /// NaN…): the reason, in words.
+    #[error("{0}")]
+    Invalid(String),
+    /// A computation's input is degenerate (a mesh with zero-area
+    /// triangles, a matching with no candidates…).
     #[error("{subject}: {reason}")]
     Degenerate {
         /// What the input is (e.g. "ARAP mesh", "piecewise matching").
@@ -69,7 +75,7 @@ pub enum Error {
     /// An option has a value the library cannot use.
     #[error("invalid option {name}: {reason}")]
     Option {
-        /// The option's name as the user knows it (e.g. `--tolerance`).
+        /// The option's field name (e.g. `tolerance`, `min_area`).
         name: &'static str,
         /// What is wrong with the value.
         reason: String,
@@ -93,11 +99,47 @@ impl Error {
         }
     }
 
-    /// An [`Error::Invalid`] for `path`.
-    pub fn invalid(path: impl Into<PathBuf>, reason: impl Into<String>) -> Self {
-        Error::Invalid {
-            path: path.into(),
-            reason: reason.into(),
+    /// An [`Error::Invalid`].
+    pub fn invalid(reason: impl Into<String>) -> Self {
+        Error::Invalid(reason.into())
+    }
+
+    /// This error as one in file `path`, unless it already names a file.
+    pub fn in_file(self, path: impl Into<PathBuf>) -> Self {
+        match self {
+            Error::Io { .. } | Error::File { .. } => self,
+            e => Error::File {
+                path: path.into(),
+                source: Box::new(e),
+            },
+        }
+    }
+
+    /// This error as one in `part` of the input (e.g. `query q-1`), unless
+    /// it already names a file.
+    pub fn in_part(self, part: impl Into<String>) -> Self {
+        match self {
+            Error::Io { .. } | Error::File { .. } => self,
+            e => Error::Part {
+                part: part.into(),
+                source: Box::new(e),
+            },
+        }
+    }
+
+    /// The file this error names, if any.
+    pub fn file(&self) -> Option<&std::path::Path> {
+        match self {
+            Error::Io { path, .. } | Error::File { path, .. } => Some(path),
+            _ => None,
+        }
+    }
+
+    /// The cause under the file and part that name where it happened.
+    pub fn cause(&self) -> &Error {
+        match self {
+            Error::File { source, .. } | Error::Part { source, .. } => source.cause(),
+            e => e,
         }
     }
 }
@@ -147,10 +189,10 @@ mod tests {
     /// on one line, its control characters escaped.
     #[test]
     fn file_names_are_shown_on_one_line() {
-        let e = Error::invalid("new\nline\t.svg", "bad");
+        let e = Error::invalid("bad").in_file("new\nline\t.svg");
         assert_eq!(e.to_string(), "new\\nline\\t.svg: bad");
         assert_eq!(
-            Error::invalid("plain ✓.svg", "bad").to_string(),
+            Error::invalid("bad").in_file("plain ✓.svg").to_string(),
             "plain ✓.svg: bad"
         );
     }
@@ -159,11 +201,11 @@ mod tests {
     fn size_errors_read_well_for_sane_and_absurd_sizes() {
         let e = |width, height| {
             Error::TooLarge {
-                path: "s.svg".into(),
                 width,
                 height,
                 limit: "L".into(),
             }
+            .in_file("s.svg")
             .to_string()
         };
         assert_eq!(

@@ -1,6 +1,7 @@
-//! File input and output shared by every mode: safe SVG parsing, size caps,
-//! and atomic writes (a temporary file renamed into place, so a failure never
-//! leaves a partial output).
+//! Files in and out at the byte level: reads capped in size (devices and
+//! pipes included), and atomic writes (a temporary file renamed into place,
+//! so a failure never leaves a partial output). The size limits of every
+//! canvas live here too.
 
 use crate::error::{Error, Result};
 use std::io::Write as _;
@@ -10,23 +11,21 @@ use std::path::Path;
 pub const MAX_FILE_BYTES: u64 = 256 << 20;
 
 /// Largest raster side in pixels, for inputs and canvases.
-pub const MAX_SIDE: u64 = 16_384;
+pub(crate) const MAX_SIDE: u64 = 16_384;
 
 /// Largest raster area in pixels (64 Mpx), for inputs and canvases.
-pub const MAX_PIXELS: u64 = 64 << 20;
+pub(crate) const MAX_PIXELS: u64 = 64 << 20;
 
 /// Checks a raster size against [`MAX_SIDE`] and [`MAX_PIXELS`] before
 /// anything is allocated.
-pub fn check_canvas(path: &Path, width: u64, height: u64) -> Result<()> {
+pub(crate) fn check_canvas(width: u64, height: u64) -> Result<()> {
     if width == 0 || height == 0 {
-        return Err(Error::invalid(
-            path,
-            format!("empty canvas ({width}×{height} px)"),
-        ));
+        return Err(Error::invalid(format!(
+            "empty canvas ({width}×{height} px)"
+        )));
     }
     if width > MAX_SIDE || height > MAX_SIDE || width.saturating_mul(height) > MAX_PIXELS {
         return Err(Error::TooLarge {
-            path: path.to_path_buf(),
             width,
             height,
             limit: format!("{MAX_SIDE} px per side, {} Mpx in all", MAX_PIXELS >> 20),
@@ -41,16 +40,14 @@ pub fn check_canvas(path: &Path, width: u64, height: u64) -> Result<()> {
 pub fn read_file(path: &Path) -> Result<Vec<u8>> {
     let meta = std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
     if meta.is_dir() {
-        return Err(Error::invalid(path, "is a directory, not a file"));
+        return Err(Error::invalid("is a directory, not a file").in_file(path));
     }
     if meta.len() > MAX_FILE_BYTES {
-        return Err(Error::invalid(
-            path,
-            format!(
-                "file of {} bytes exceeds the limit of {MAX_FILE_BYTES} bytes",
-                meta.len()
-            ),
-        ));
+        return Err(Error::invalid(format!(
+            "file of {} bytes exceeds the limit of {MAX_FILE_BYTES} bytes",
+            meta.len()
+        ))
+        .in_file(path));
     }
     read_capped(path, MAX_FILE_BYTES)
 }
@@ -65,10 +62,7 @@ fn read_capped(path: &Path, cap: u64) -> Result<Vec<u8>> {
         .read_to_end(&mut out)
         .map_err(|e| Error::io(path, e))?;
     if out.len() as u64 > cap {
-        return Err(Error::invalid(
-            path,
-            format!("file exceeds the limit of {cap} bytes"),
-        ));
+        return Err(Error::invalid(format!("file exceeds the limit of {cap} bytes")).in_file(path));
     }
     Ok(out)
 }

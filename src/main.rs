@@ -2,11 +2,10 @@
 //! reports. Exit status: 0 success, 1 failure, 2 usage error.
 
 use clap::{Args, Parser, Subcommand};
-use flourish::fill::{self, FillOptions};
-use flourish::pattern::{self, PatternOptions};
-use flourish::read::ink::InputOptions;
-use flourish::trace::TraceOptions;
-use flourish::{diff, io, render, trace, Error};
+use flourish::{
+    io, BrushOptions, Error, FillOptions, Image, ImageOptions, Library, Output, PatternOptions,
+    Refinement, Sketch, StyleKind, StyleOptions, Styles, TraceOptions,
+};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -216,8 +215,15 @@ enum Failure {
 }
 
 impl From<Error> for Failure {
+    /// An option the library refuses is a usage error, named by its flag.
     fn from(e: Error) -> Self {
-        Failure::Run(e)
+        match e {
+            Error::Option { name, reason } => Failure::Usage(format!(
+                "invalid option --{}: {reason}",
+                name.replace('_', "-")
+            )),
+            e => Failure::Run(e),
+        }
     }
 }
 
@@ -248,10 +254,6 @@ fn main() -> ExitCode {
 /// started up front; a million of them never finish starting).
 const MAX_THREADS: usize = 1024;
 
-/// Most correction iterations per level `brush --iterations` may ask for
-/// (each costs about one synthesis pass).
-const MAX_ITERATIONS: usize = 100;
-
 fn run(cli: Cli) -> Result<(), Failure> {
     if let Some(n) = cli.threads {
         if n == 0 {
@@ -280,7 +282,7 @@ fn run(cli: Cli) -> Result<(), Failure> {
 }
 
 fn run_trace(args: TraceArgs, quiet: bool, verbose: bool) -> Result<(), Failure> {
-    let input = InputOptions {
+    let input = ImageOptions {
         resolution: args.resolution,
         invert: args.invert,
         layers: args.layers,
@@ -289,35 +291,38 @@ fn run_trace(args: TraceArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
         tolerance: args.tolerance,
         min_area: args.min_area,
     };
-    opts.validate().map_err(|e| Failure::Usage(e.to_string()))?;
-    if args.resolution == 0 {
-        return Err(Failure::Usage("--resolution must be at least 1 px".into()));
-    }
+    opts.validate()?;
+    input.validate()?;
     let job = |inp: &Path| -> Result<String, Error> {
-        let doc = trace::trace_file(inp, &input, &opts)?;
-        if !quiet {
-            for w in &doc.warnings {
-                eprintln!("flourish: warning: {}: {w}", inp.display());
-            }
-        }
-        if verbose {
-            for note in &doc.notes {
-                eprintln!("flourish: {}: {note}", inp.display());
-            }
-        }
-        Ok(doc.to_svg())
+        let bytes = io::read_file(inp)?;
+        let out = Image::from_bytes(&bytes, &input)
+            .and_then(|image| flourish::trace(&image, &opts))
+            .map_err(|e| e.in_file(inp))?;
+        Ok(report(inp, out, quiet, verbose))
     };
     run_batch(&args.inputs, &args.out, quiet, &job)
 }
 
+/// Prints what a run has to tell about input `inp` (warnings unless
+/// `quiet`, notes under `verbose`) and gives its SVG.
+fn report(inp: &Path, out: Output, quiet: bool, verbose: bool) -> String {
+    if !quiet {
+        for w in &out.warnings {
+            eprintln!("flourish: warning: {}: {w}", inp.display());
+        }
+    }
+    if verbose {
+        for note in &out.notes {
+            eprintln!("flourish: {}: {note}", inp.display());
+        }
+    }
+    out.to_svg()
+}
+
 /// Reads a sketch and reports what it skipped: warnings unless `quiet`,
 /// notes under `verbose`.
-fn load_sketch(
-    path: &Path,
-    quiet: bool,
-    verbose: bool,
-) -> Result<flourish::read::sketch::Sketch, Error> {
-    let sk = flourish::read::sketch::load(path)?;
+fn load_sketch(path: &Path, quiet: bool, verbose: bool) -> Result<Sketch, Error> {
+    let sk = read_sketch(path)?;
     if !quiet {
         for w in &sk.warnings {
             eprintln!("flourish: warning: {}: {w}", path.display());
@@ -331,6 +336,11 @@ fn load_sketch(
     Ok(sk)
 }
 
+/// Reads and parses a sketch file; errors name it.
+fn read_sketch(path: &Path) -> Result<Sketch, Error> {
+    Sketch::from_svg(&io::read_file(path)?).map_err(|e| e.in_file(path))
+}
+
 /// Makes output folder `dir` (and its parents) unless it exists; a file
 /// in its place is an error.
 fn make_folder(dir: &Path) -> Result<(), Failure> {
@@ -338,89 +348,98 @@ fn make_folder(dir: &Path) -> Result<(), Failure> {
         return Ok(());
     }
     if dir.exists() {
-        return Err(Failure::Run(Error::invalid(
-            dir,
-            "is not a folder (--out-dir and, with it, --preview name folders)",
-        )));
+        return Err(Failure::Run(
+            Error::invalid("is not a folder (--out-dir and, with it, --preview name folders)")
+                .in_file(dir),
+        ));
     }
     std::fs::create_dir_all(dir).map_err(|e| {
-        Failure::Run(Error::invalid(
-            dir,
-            format!("cannot make the output folder: {e}"),
-        ))
+        Failure::Run(Error::invalid(format!("cannot make the output folder: {e}")).in_file(dir))
     })
 }
 
-/// The `--styles` folder, or the default styles folder.
-fn styles_dir(arg: &Option<PathBuf>) -> PathBuf {
-    arg.clone()
-        .unwrap_or_else(flourish::read::style::default_styles_dir)
+/// The `--styles` folder, or the shipped styles.
+fn library(arg: &Option<PathBuf>) -> Library {
+    match arg {
+        Some(dir) => Library::new([dir.clone()]),
+        None => Library::shipped(),
+    }
 }
 
 fn run_pattern(args: PatternArgs, quiet: bool, verbose: bool) -> Result<(), Failure> {
-    if !(args.variation.is_finite() && (0.0..=1.0).contains(&args.variation)) {
-        return Err(Failure::Usage(format!(
-            "--variation {} is not in 0..=1",
-            args.variation
-        )));
-    }
     let opts = PatternOptions {
-        style: args.style.clone(),
-        styles_dir: styles_dir(&args.styles),
         seed: args.out.seed,
         variation: args.variation,
         ..PatternOptions::default()
     };
+    opts.validate()?;
+    let lib = library(&args.styles);
+    let load = StyleOptions {
+        kind: Some(StyleKind::Pattern),
+        ..StyleOptions::default()
+    };
+    let style = lib.load(&args.style, &load)?;
     let job = |sketch: &Path| -> Result<String, Error> {
         let sk = load_sketch(sketch, quiet, verbose)?;
-        Ok(pattern::synthesize_sketch(&opts, &sk)?
-            .to_document()
-            .to_svg())
+        let out = lib
+            .load_named(&sk, StyleKind::Pattern, &load)
+            .and_then(|named| flourish::pattern(&sk, Styles::new(&style, &named), &opts))
+            .map_err(|e| e.in_file(sketch))?;
+        Ok(report(sketch, out, quiet, verbose))
     };
     run_batch(&args.sketches, &args.out, quiet, &job)
 }
 
 fn run_fill(args: FillArgs, quiet: bool, verbose: bool) -> Result<(), Failure> {
-    if let Some(r) = args.resolution {
-        if !(8..=1024).contains(&r) {
-            return Err(Failure::Usage(format!(
-                "--resolution {r} is not in 8..=1024 px"
-            )));
-        }
-    }
-    let opts = FillOptions {
-        style: args.style.clone(),
-        styles_dir: styles_dir(&args.styles),
-        seed: args.out.seed,
-        direction: args.direction.clone(),
+    let load = StyleOptions {
+        kind: Some(StyleKind::Fill),
         resolution: args.resolution,
+        ..StyleOptions::default()
+    };
+    load.validate()?;
+    let direction = match &args.direction {
+        Some(d) => {
+            let sk = read_sketch(d)?;
+            let probe = FillOptions {
+                direction: Some(sk.clone()),
+                ..FillOptions::default()
+            };
+            // A direction sketch that combs nothing is a fault of that file.
+            if let Err(Error::Option { reason, .. }) = probe.validate() {
+                return Err(Failure::Run(Error::invalid(reason).in_file(d)));
+            }
+            Some(sk)
+        }
+        None => None,
+    };
+    let opts = FillOptions {
+        seed: args.out.seed,
+        direction,
         ..FillOptions::default()
     };
+    opts.validate()?;
+    let lib = library(&args.styles);
+    let style = lib.load(&args.style, &load)?;
     let job = |sketch: &Path| -> Result<String, Error> {
         let sk = load_sketch(sketch, quiet, verbose)?;
-        let out = fill::fill_sketch(&opts, &sk)?;
-        if verbose {
-            for note in &out.notes {
-                eprintln!("flourish: {}: {note}", sketch.display());
-            }
-        }
-        Ok(out.to_document().to_svg())
+        let out = lib
+            .load_named(&sk, StyleKind::Fill, &load)
+            .and_then(|named| flourish::fill(&sk, Styles::new(&style, &named), &opts))
+            .map_err(|e| e.in_file(sketch))?;
+        Ok(report(sketch, out, quiet, verbose))
     };
     run_batch(&args.sketches, &args.out, quiet, &job)
 }
 
 fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure> {
-    use flourish::brush::analysis::{AnalysisOptions, BrushStyle};
-    use flourish::brush::{output::brush_sketch, pipeline::BrushOptions};
     if args.variations == 0 || args.variations > 100 {
         return Err(Failure::Usage("--variations must be in 1..=100".into()));
     }
-    if args.iterations > MAX_ITERATIONS {
-        return Err(Failure::Usage(format!(
-            "--iterations {} is not in 0..={MAX_ITERATIONS}",
-            args.iterations
-        )));
+    BrushOptions {
+        iterations: args.iterations,
+        ..BrushOptions::default()
     }
+    .validate()?;
     if args.variations > 1
         && args.out.out_dir.is_none()
         && (args.out.output.is_none() || args.out.output.as_deref() == Some(Path::new("-")))
@@ -429,52 +448,33 @@ fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
             "--variations needs -o OUT.svg (a file) or --out-dir DIR".into(),
         ));
     }
-    let styles = styles_dir(&args.styles);
-    let dir = flourish::read::style::resolve(&args.style, &styles)?;
-    let analysis = AnalysisOptions {
-        cache_dir: args.cache.clone(),
-        ..AnalysisOptions::default()
+    let refine = match &args.refine {
+        Some(path) => {
+            Some(Refinement::from_svg(&io::read_file(path)?).map_err(|e| e.in_file(path))?)
+        }
+        None => None,
     };
-    let style = BrushStyle::load(&dir, &analysis)?;
+    let style = library(&args.styles).load(
+        &args.style,
+        &StyleOptions {
+            kind: Some(StyleKind::Brush),
+            cache_dir: args.cache.clone(),
+            ..StyleOptions::default()
+        },
+    )?;
     for k in 0..args.variations {
         let opts = BrushOptions {
             seed: args.out.seed.wrapping_add(k as u64),
             art_brush: args.art_brush,
-            refine: args.refine.clone(),
-            // Only --verbose reads the fields (each query's energy).
-            discard_fields: !verbose,
-            synth: flourish::brush::synth::SynthOptions {
-                iterations: args.iterations,
-                ..Default::default()
-            },
-            ..BrushOptions::default()
+            iterations: args.iterations,
+            refine: refine.clone(),
+            // Only --verbose prints each query's energy.
+            measure: verbose,
         };
         let job = |sketch: &Path| -> Result<String, Error> {
             let sk = load_sketch(sketch, quiet, verbose)?;
-            let out = brush_sketch(&style, &sk, &opts)?;
-            if !quiet {
-                for w in &out.warnings {
-                    eprintln!("flourish: warning: {w}");
-                }
-            }
-            if verbose {
-                for n in &out.notes {
-                    eprintln!("flourish: {n}");
-                }
-                for (i, q) in out.queries.iter().enumerate() {
-                    eprintln!(
-                        "flourish: {}: query {} ({}): {} segments, canvas {}×{} px, energy {:.4}",
-                        sketch.display(),
-                        i + 1,
-                        q.spine.query_id,
-                        q.segments.len(),
-                        q.canvas.width,
-                        q.canvas.height,
-                        q.energy(&style)
-                    );
-                }
-            }
-            Ok(out.document.to_svg())
+            let out = flourish::brush(&sk, &style, &opts).map_err(|e| e.in_file(sketch))?;
+            Ok(report(sketch, out, quiet, verbose))
         };
         let suffixed = |p: &Path| -> PathBuf {
             if args.variations == 1 {
@@ -626,7 +626,7 @@ fn run_jobs(
 fn write_outputs(out: &Path, svg: &str, preview: Option<&Path>) -> Result<(), Error> {
     match preview {
         Some(p) => {
-            let png = render::preview_png(svg, p)?;
+            let png = flourish::preview_png(svg).map_err(|e| e.in_file(p))?;
             io::write_all_atomic(&[(out, svg.as_bytes()), (p, &png)])
         }
         None => io::write_atomic(out, svg.as_bytes()),
@@ -645,10 +645,9 @@ fn named(inp: &Path, variant: Option<u32>, ext: &str) -> PathBuf {
 
 fn check_not_input(input: &Path, output: &Path) -> Result<(), Failure> {
     if output.as_os_str() != "-" && io::same_file(input, output) {
-        return Err(Failure::Run(Error::invalid(
-            output,
-            "output would overwrite the input",
-        )));
+        return Err(Failure::Run(
+            Error::invalid("output would overwrite the input").in_file(output),
+        ));
     }
     Ok(())
 }
@@ -664,9 +663,9 @@ fn run_diff(args: DiffArgs, quiet: bool) -> Result<(), Failure> {
         check_not_input(&args.expected, out)?;
         check_not_input(&args.actual, out)?;
     }
-    let report = diff::diff_files(&args.expected, &args.actual)?;
+    let report = flourish::diff(&args.expected, &args.actual)?;
     if let Some(out) = &args.out {
-        diff::write_panels(&report, out)?;
+        io::write_atomic(out, &report.panels_png().map_err(|e| e.in_file(out))?)?;
     }
     if !quiet {
         println!(
@@ -683,36 +682,31 @@ fn run_diff(args: DiffArgs, quiet: bool) -> Result<(), Failure> {
 }
 
 fn run_style_check(args: StyleCheckArgs, quiet: bool) -> Result<(), Failure> {
-    use flourish::brush::analysis::{self as brush, check};
-    use flourish::read::style;
-    let styles_dir = args.styles.unwrap_or_else(style::default_styles_dir);
-    let dir = style::resolve(&args.style, &styles_dir)?;
+    let style = library(&args.styles).load(
+        &args.style,
+        &StyleOptions {
+            kind: Some(StyleKind::Brush),
+            cache_dir: args.cache,
+            use_cache: !args.no_cache,
+            ..StyleOptions::default()
+        },
+    )?;
     if let Some(sheet) = &args.sheet {
         // The sheet must not replace the style's own files.
-        let toml = style::load(&dir)?;
-        check_not_input(&dir.join(style::STYLE_FILE), sheet)?;
-        for ex in &toml.exemplar {
-            check_not_input(&dir.join(&ex.file), sheet)?;
+        for file in style.files() {
+            check_not_input(file, sheet)?;
         }
     }
-    let opts = brush::AnalysisOptions {
-        cache_dir: args.cache,
-        use_cache: !args.no_cache,
-        ..brush::AnalysisOptions::default()
-    };
-    let analysed = brush::BrushStyle::load(&dir, &opts)?;
-    let report = check::check(&analysed, &check::CheckOptions::default());
+    let report = flourish::check_style(&style)?;
     if let Some(sheet) = &args.sheet {
-        let png = check::sheet_png(&analysed, sheet)?;
+        let png = flourish::style_sheet(&style).map_err(|e| e.in_file(sheet))?;
         io::write_atomic(sheet, &png)?;
     }
     if !quiet {
         print!("{}", report.to_text());
     } else {
-        for e in &report.exemplars {
-            for w in &e.warnings {
-                eprintln!("flourish: {}: {w}", dir.join(&e.file).display());
-            }
+        for (file, w) in report.warnings() {
+            eprintln!("flourish: {}: {w}", style.dir().join(file).display());
         }
     }
     if args.strict && report.warning_count() > 0 {

@@ -138,14 +138,39 @@ pub struct Document {
     pub view_box: Rect,
     /// Groups in drawing order.
     pub groups: Vec<Group>,
-    /// Decimals written for coordinates (see [`decimals_for`]).
+    /// Decimals written for coordinates: enough that rounding moves a
+    /// point by at most a tenth of the tracing tolerance.
     pub decimals: u32,
-    /// What the input held that the document leaves out, one line each
-    /// (not written to the SVG; the command line prints them).
+}
+
+/// What a mode makes of its input: the document, and what to tell the
+/// user about it.
+#[derive(Clone, Debug)]
+pub struct Output {
+    /// The output SVG document (the size and viewBox of the input).
+    pub document: Document,
+    /// What the input held that the output leaves out, one line each (the
+    /// command line prints them unless `--quiet`).
     pub warnings: Vec<String>,
-    /// What was done to the input on the way, one line each (not written
-    /// to the SVG; the command line prints them under `--verbose`).
+    /// How the input was read and made, one line each (the command line
+    /// prints them under `--verbose`).
     pub notes: Vec<String>,
+}
+
+impl Output {
+    /// A document with nothing to tell.
+    pub fn new(document: Document) -> Self {
+        Output {
+            document,
+            warnings: Vec::new(),
+            notes: Vec::new(),
+        }
+    }
+
+    /// The document as SVG text.
+    pub fn to_svg(&self) -> String {
+        self.document.to_svg()
+    }
 }
 
 /// The number of decimals needed so that rounding moves a point by at most a
@@ -167,8 +192,6 @@ impl Document {
             view_box: Rect::new(0.0, 0.0, width, height),
             groups: Vec::new(),
             decimals,
-            warnings: Vec::new(),
-            notes: Vec::new(),
         }
     }
 

@@ -231,7 +231,7 @@ fn hausdorff_of_known_shapes() {
     use kurbo::{Circle, Shape};
     let truth_path = Circle::new((50.0, 50.0), 20.0).to_path(1e-4);
     let mut truth = Vec::new();
-    flourish::raster::vector::flatten_segments(&truth_path, 0.001, &mut truth);
+    support::flatten_segments(&truth_path, 0.001, &mut truth);
     let same = Circle::new((50.0, 50.0), 20.0).to_path(1e-4);
     let d = support::max_deviation(&[same], &truth);
     assert!(d < 0.02, "{d}");

@@ -345,11 +345,6 @@ impl Arap {
             })
             .collect()
     }
-
-    /// Number of free (unpinned) vertices.
-    pub fn free_vertices(&self) -> usize {
-        self.n_free
-    }
 }
 
 /// Adds the 2×2 block `m` at (`r`, `c`).
@@ -396,6 +391,7 @@ fn fit_matrix(x: f64, y: f64) -> Matrix6x4<f64> {
 /// The singular values (σ1 ≥ σ2) of the deformation gradient of triangle
 /// `tri` from `rest` to `deformed` positions (`(∞, 0)` for a degenerate
 /// or out-of-range triangle).
+#[cfg(test)]
 pub fn triangle_stretches(rest: &[Point], deformed: &[Point], tri: [usize; 3]) -> (f64, f64) {
     let (Some(a), Some(b), Some(c), Some(p), Some(q), Some(r)) = (
         rest.get(tri[0]),
@@ -422,6 +418,7 @@ pub fn triangle_stretches(rest: &[Point], deformed: &[Point], tri: [usize; 3]) -
 
 /// Mean over triangles of |σ1 − 1| + |σ2 − 1|, the distortion of `deformed`
 /// relative to the rest mesh (0 for a rigid motion).
+#[cfg(test)]
 pub fn mean_distortion(mesh: &RibMesh, deformed: &[Point]) -> f64 {
     if mesh.triangles.is_empty() || deformed.len() != mesh.rest.len() {
         return f64::INFINITY;
@@ -461,11 +458,7 @@ pub fn rasterize_coords(
             ),
         ));
     }
-    crate::io::check_canvas(
-        std::path::Path::new("brush canvas"),
-        width as u64,
-        height as u64,
-    )?;
+    crate::io::check_canvas(width as u64, height as u64).map_err(|e| e.in_part("brush canvas"))?;
     let mut grid = Grid::new(width, height, None);
     for tri in &mesh.triangles {
         let [Some(p0), Some(p1), Some(p2)] = tri.map(|v| deformed.get(v).map(|p| to_pixel * *p))

@@ -88,6 +88,7 @@ fn link(params: &SeamParams, lp: f64, rp: f64, lq: f64, rq: f64) -> i64 {
 /// widened by `margin` pixels (so the single-covered pixels bordering the
 /// overlap tie the cut to its segments), or `None` when they do not
 /// overlap or the masks differ in size.
+#[cfg(test)]
 pub fn overlap_cover(
     a: &Grid<bool>,
     b: &Grid<bool>,

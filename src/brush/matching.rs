@@ -36,6 +36,7 @@
 use crate::brush::query::QuerySpine;
 use crate::error::{Error, Result};
 use crate::rng;
+#[cfg(test)]
 use kurbo::Point;
 use std::collections::HashMap;
 use std::ops::Range;
@@ -72,6 +73,7 @@ impl SpineFeatures {
     /// common length unit): turning angles and end distances from the
     /// spine, width from the rib length `|left − right|`, and the given
     /// appearance descriptors (one per rib, or none).
+    #[cfg(test)]
     pub fn from_ribs(
         spine: &[Point],
         left: &[Point],
@@ -409,12 +411,14 @@ impl<'a> Problem<'a> {
 
     /// The effective longest segment, if limited: the option, at least the
     /// effective shortest.
+    #[cfg(test)]
     pub fn max_segment(&self) -> Option<usize> {
         self.opts.max_segment.map(|m| m.max(self.min_segment()))
     }
 
     /// The cost of a segmentation given as (exemplar, first exemplar sample,
     /// query range) triples tiling the query, as the DP counts it.
+    #[cfg(test)]
     pub fn cost_of(&self, segs: &[(usize, usize, Range<usize>)]) -> f64 {
         let mut c = 0.0;
         let mut last: Option<(usize, usize)> = None;

@@ -73,6 +73,7 @@ impl FlowGraph {
     /// graph, then blocking flows by iterative depth-first search with
     /// current-arc pointers): the reference for [`FlowGraph::max_flow`].
     /// Leaves the residual network for [`FlowGraph::source_side`].
+    #[cfg(test)]
     pub fn max_flow_dinic(&mut self, s: usize, t: usize) -> i64 {
         let n = self.head.len();
         if s >= n || t >= n || s == t {

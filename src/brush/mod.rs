@@ -34,3 +34,120 @@ pub mod pipeline;
 pub mod query;
 pub mod ribs;
 pub mod synth;
+
+use crate::error::{Error, Result};
+use crate::read::sketch::Sketch;
+use crate::svg_out::Output;
+use analysis::BrushStyle;
+use resvg::usvg;
+use std::sync::Arc;
+
+/// Most correction iterations per synthesis level (each costs about one
+/// synthesis pass).
+pub const MAX_ITERATIONS: usize = 100;
+
+/// Options of [`crate::brush()`].
+#[derive(Clone, Debug)]
+pub struct BrushOptions {
+    /// Seeds every choice among near-equal candidates: matching ties and
+    /// synthesis candidates (default 0).
+    pub seed: u64,
+    /// Draw the art-brush baseline instead: one exemplar stretched along
+    /// the whole path (default `false`).
+    pub art_brush: bool,
+    /// Correction iterations per synthesis level, 0..=[`MAX_ITERATIONS`]
+    /// (0: the graph cut, upsampled; default 1).
+    pub iterations: usize,
+    /// A refinement sketch (DecoBrush §5.5): its black strokes add
+    /// ornament, its white ones erase it (default `None`).
+    pub refine: Option<Refinement>,
+    /// Add a note per query with its matched segments, canvas size and
+    /// synthesis energy; the energy costs about one correction pass per
+    /// query (default `false`).
+    pub measure: bool,
+}
+
+impl Default for BrushOptions {
+    fn default() -> Self {
+        BrushOptions {
+            seed: 0,
+            art_brush: false,
+            iterations: 1,
+            refine: None,
+            measure: false,
+        }
+    }
+}
+
+impl BrushOptions {
+    /// Checks every value's range.
+    pub fn validate(&self) -> Result<()> {
+        if self.iterations > MAX_ITERATIONS {
+            return Err(Error::Option {
+                name: "iterations",
+                reason: format!("{} is not in 0..={MAX_ITERATIONS}", self.iterations),
+            });
+        }
+        Ok(())
+    }
+
+    /// The pipeline's settings for these options.
+    pub(crate) fn settings(&self) -> pipeline::Settings {
+        pipeline::Settings {
+            seed: self.seed,
+            art_brush: self.art_brush,
+            refine: self.refine.clone(),
+            // Only a measuring run reads the fields after tracing.
+            discard_fields: !self.measure,
+            synth: synth::SynthOptions {
+                iterations: self.iterations,
+                ..Default::default()
+            },
+            ..pipeline::Settings::default()
+        }
+    }
+}
+
+/// A refinement sketch (DecoBrush §5.5): an SVG of the sketch's size and
+/// viewBox whose opaque dark pixels add ornament and light ones erase it.
+#[derive(Clone, Debug)]
+pub struct Refinement {
+    tree: Arc<usvg::Tree>,
+}
+
+impl Refinement {
+    /// Parses refinement SVG bytes (plain or SVGZ).
+    pub fn from_svg(bytes: &[u8]) -> Result<Refinement> {
+        Ok(Refinement {
+            tree: Arc::new(crate::read::svg::parse_svg(bytes)?),
+        })
+    }
+}
+
+/// Brushes every open path of `sketch` with `style` ([`crate::brush()`]).
+pub fn run(style: &BrushStyle, sketch: &Sketch, opts: &BrushOptions) -> Result<Output> {
+    opts.validate()?;
+    let out = output::brush_sketch(style, sketch, &opts.settings())?;
+    let mut notes = out.notes;
+    if opts.measure {
+        for (i, q) in out.queries.iter().enumerate() {
+            notes.push(format!(
+                "query {} ({}): {} segments, canvas {}×{} px, energy {:.4}",
+                i + 1,
+                q.spine.query_id,
+                q.segments.len(),
+                q.canvas.width,
+                q.canvas.height,
+                q.energy(style)
+            ));
+        }
+    }
+    Ok(Output {
+        document: out.document,
+        warnings: out.warnings,
+        notes,
+    })
+}
+
+#[cfg(test)]
+mod tests;

@@ -3,7 +3,7 @@
 //! the query's canvas, traced to Béziers, one `<g>` per query in drawing
 //! order with the layers' colours, bottom layer first.
 
-use super::pipeline::{as_branch, brush_query, starts_on, BrushOptions, QueryResult};
+use super::pipeline::{as_branch, brush_query, starts_on, QueryResult, Settings};
 use super::query::{self, QuerySpine};
 use super::synth::{self, Coord, Field};
 use crate::brush::analysis::BrushStyle;
@@ -176,28 +176,6 @@ const NEIGHBOURS: [(isize, isize); 8] = [
     (1, 1),
 ];
 
-/// The canvas SDF of one layer colour (or of all ink, `None`) for a
-/// synthesized query, px; `PAPER` off the ornament. Each pixel `p`
-/// blends the predictions of its 3×3 neighbourhood: neighbour `q` predicts
-/// the coordinate `μ(q) + J(q)(p − q)` (its patch continued to `p`,
-/// [`synth::jacobian`]) and gives the exemplar's SDF there (bilinear);
-/// the values are averaged with binomial weights 1-2-1 (a neighbour whose
-/// exemplar lacks the colour gives paper). Inside a coherent patch every
-/// prediction is `μ(p)` itself and the read is exact; across a seam the
-/// two patches' fields are cross-faded over three pixels, so outlines
-/// cross seams without steps or spurs, and a lone pixel whose μ landed on
-/// another layer's ink (a speck) is outvoted by its neighbours (the
-/// output reading of decobrush.txt §5.4: colours are read through μ, §7).
-pub fn layer_sdf(style: &BrushStyle, r: &QueryResult, color: Option<Color>) -> Grid<f32> {
-    let field = extend_field(style, &r.field, border_rings(r));
-    blended_sdf(style, &field, color)
-}
-
-/// [`layer_sdf`] of a given (already extended) field.
-pub fn blended_sdf(style: &BrushStyle, field: &Field, color: Option<Color>) -> Grid<f32> {
-    blended_sdf_with(style, field, &jacobians(style, field), color)
-}
-
 /// The Jacobian of every pixel of a field ([`synth::jacobian`]), row-major.
 fn jacobians(style: &BrushStyle, field: &Field) -> Vec<Option<synth::Jacobian>> {
     let (w, h) = (field.coords.width(), field.coords.height());
@@ -360,6 +338,7 @@ pub fn smallest_exemplar_component(style: &BrushStyle) -> usize {
 /// ([`smallest_exemplar_component`], the threshold taken from the style,
 /// not a constant) are synthesis debris and are cleared; the query's
 /// largest piece is its body and always stays.
+#[cfg(test)]
 pub fn final_layers(style: &BrushStyle, r: &QueryResult) -> Vec<(Color, Grid<f32>)> {
     final_layers_with(style, r, &StyleFacts::of(style))
 }
@@ -426,6 +405,7 @@ fn final_layers_with(
 
 /// Traces a synthesized query into one group of filled shapes, bottom
 /// layer first.
+#[cfg(test)]
 pub fn trace_query(style: &BrushStyle, r: &QueryResult, id: String, opts: &TraceOptions) -> Group {
     trace_query_with(style, r, id, opts, &StyleFacts::of(style))
 }
@@ -456,7 +436,7 @@ fn trace_query_with(
 /// starting on an earlier one has its start treated as a middle.
 pub fn prepared_spines(
     sketch: &Sketch,
-    opts: &BrushOptions,
+    opts: &Settings,
 ) -> Result<(Vec<QuerySpine>, Vec<String>, Vec<String>)> {
     let set = query::spines(sketch, &opts.query)?;
     if set.spines.is_empty() {
@@ -464,18 +444,16 @@ pub fn prepared_spines(
             Some(w) => format!(" ({} skipped; first: {w})", set.warnings.len()),
             None => String::new(),
         };
-        return Err(Error::invalid(
-            &sketch.path,
-            format!("no open paths to brush along (draw stroked paths without fill){skipped}"),
-        ));
+        return Err(Error::invalid(format!(
+            "no open paths to brush along (draw stroked paths without fill){skipped}"
+        )));
     }
     let mut spines: Vec<QuerySpine> = Vec::with_capacity(set.spines.len());
     let mut notes = set.notes;
     for mut q in set.spines {
         if starts_on(&q, &spines) {
             notes.push(format!(
-                "{}: query {} starts on an earlier stroke and branches from it",
-                sketch.path.display(),
+                "query {} starts on an earlier stroke and branches from it",
                 q.query_id
             ));
             as_branch(&mut q);
@@ -493,7 +471,7 @@ fn refine_one(
     style: &BrushStyle,
     mut r: QueryResult,
     tree: &resvg::usvg::Tree,
-    opts: &BrushOptions,
+    opts: &Settings,
 ) -> QueryResult {
     let sopts = crate::brush::synth::SynthOptions {
         seed: opts.seed,
@@ -556,41 +534,18 @@ fn refine_one(
 /// Runs the brush pipeline on every open path of `sketch` (queries in
 /// parallel, results in drawing order) and writes the document. Each query
 /// is synthesized, refined and traced in one go, so with
-/// [`BrushOptions::discard_fields`] only the queries in flight hold their
+/// [`Settings::discard_fields`] only the queries in flight hold their
 /// fields.
-pub fn brush_sketch(
-    style: &BrushStyle,
-    sketch: &Sketch,
-    opts: &BrushOptions,
-) -> Result<BrushOutput> {
+pub fn brush_sketch(style: &BrushStyle, sketch: &Sketch, opts: &Settings) -> Result<BrushOutput> {
     let (spines, warnings, notes) = prepared_spines(sketch, opts)?;
-    let refine = match &opts.refine {
-        Some(path) => Some(crate::read::svg::load_svg(path)?),
-        None => None,
-    };
+    let refine = opts.refine.as_ref().map(|r| &*r.tree);
     let trace = TraceOptions::default();
     let facts = StyleFacts::of(style);
     let done: Vec<(QueryResult, Group)> = spines
         .par_iter()
         .map(|q| {
-            let r = brush_query(style, q, opts).map_err(|e| match e {
-                Error::TooLarge {
-                    width,
-                    height,
-                    limit,
-                    ..
-                } => Error::TooLarge {
-                    path: format!("{}: query {}", sketch.path.display(), q.query_id).into(),
-                    width,
-                    height,
-                    limit,
-                },
-                Error::Degenerate { subject, reason } => Error::Degenerate {
-                    subject: format!("{}: {subject}", sketch.path.display()),
-                    reason,
-                },
-                other => other,
-            })?;
+            let r = brush_query(style, q, opts)
+                .map_err(|e| e.in_part(format!("query {}", q.query_id)))?;
             let mut r = match &refine {
                 Some(tree) => refine_one(style, r, tree, opts),
                 None => r,

@@ -19,17 +19,18 @@ use super::baseline::art_brush_coords;
 use super::graphcut::{seam, Cover, Label, SeamParams};
 use super::matching::{match_query, MatchOptions, SpineFeatures};
 use super::query::{QueryOptions, QuerySpine};
+pub use super::ribs::exemplar_width;
 use super::ribs::{exemplar_features, resample_ribs};
-pub use super::ribs::{exemplar_width, WIDTH_PERCENTILE};
 use super::synth::{self, Coord, Field, SynthOptions};
 use crate::brush::analysis::BrushStyle;
 use crate::error::{Error, Result};
 use crate::raster::Grid;
 use kurbo::{Affine, Point, Vec2};
 
-/// Everything the pipeline can be told.
+/// Everything the pipeline can be told: the face's [`crate::BrushOptions`] and
+/// the stages' own settings, which tests and benchmarks reach.
 #[derive(Clone, Debug, Default)]
-pub struct BrushOptions {
+pub struct Settings {
     /// Query spine resampling.
     pub query: QueryOptions,
     /// Piecewise matching (its `seed` is overwritten by [`Self::seed`]).
@@ -49,7 +50,7 @@ pub struct BrushOptions {
     pub start_level: Option<usize>,
     /// A refinement sketch (§5.5, `--refine`): black strokes add ink,
     /// white ones erase it; same viewBox as the sketch.
-    pub refine: Option<std::path::PathBuf>,
+    pub refine: Option<super::Refinement>,
     /// Drop each query's synthesized fields once it is traced: the
     /// [`QueryResult`]s of [`crate::brush::output::BrushOutput`] keep their
     /// spine, canvas and segments but an empty `field` and no `levels`, so
@@ -78,12 +79,12 @@ pub struct Canvas {
 impl Canvas {
     /// Canvas pixel coordinates at level scale `s` (1 = finest) of a
     /// sketch point.
-    pub fn to_pixel(&self, s: f64) -> Affine {
+    pub fn to_pixel(self, s: f64) -> Affine {
         Affine::scale(self.px_per_unit * s) * Affine::translate(-self.origin.to_vec2())
     }
 
     /// Sketch coordinates of a finest-level pixel-space point.
-    pub fn to_user(&self) -> Affine {
+    pub fn to_user(self) -> Affine {
         Affine::translate(self.origin.to_vec2()) * Affine::scale(1.0 / self.px_per_unit)
     }
 }
@@ -156,22 +157,16 @@ pub fn canvas_for(q: &QuerySpine, ew: f64, factor: usize) -> Result<Canvas> {
     let f = factor.max(1) as f64;
     let cw = ((x1 - x0 + 2.0 * m) * ppu / f).ceil();
     let ch = ((y1 - y0 + 2.0 * m) * ppu / f).ceil();
-    let what = std::path::Path::new(if q.query_id.is_empty() {
-        "query"
-    } else {
-        &q.query_id
-    });
     if !(cw.is_finite() && ch.is_finite() && cw >= 1.0 && ch >= 1.0) {
-        return Err(Error::invalid(what, "the stroke gives an empty canvas"));
+        return Err(Error::invalid("the stroke gives an empty canvas"));
     }
     let (width, height) = (
         (cw * f).min(u64::MAX as f64) as u64,
         (ch * f).min(u64::MAX as f64) as u64,
     );
-    crate::io::check_canvas(what, width, height)?;
+    crate::io::check_canvas(width, height)?;
     if width.saturating_mul(height) > MAX_BRUSH_PIXELS {
         return Err(Error::TooLarge {
-            path: what.to_path_buf(),
             width,
             height,
             limit: format!(
@@ -418,20 +413,14 @@ pub fn as_branch(q: &mut QuerySpine) {
 }
 
 /// Synthesizes one query spine (see the module docs).
-pub fn brush_query(style: &BrushStyle, q: &QuerySpine, opts: &BrushOptions) -> Result<QueryResult> {
+pub fn brush_query(style: &BrushStyle, q: &QuerySpine, opts: &Settings) -> Result<QueryResult> {
     run_query(style, q, opts, false)
-}
-
-/// The coarsest-level field after matching, ARAP and seams, before any
-/// correction (§5.4.1).
-pub fn coarse_init(style: &BrushStyle, q: &QuerySpine, opts: &BrushOptions) -> Result<Field> {
-    Ok(run_query(style, q, opts, true)?.field)
 }
 
 fn run_query(
     style: &BrushStyle,
     q: &QuerySpine,
-    opts: &BrushOptions,
+    opts: &Settings,
     stop_at_init: bool,
 ) -> Result<QueryResult> {
     let levels = style.exemplars.first().map(|e| e.levels.len()).unwrap_or(0);

@@ -101,31 +101,30 @@ pub struct QuerySet {
 /// the sketch file.
 pub fn spines(sketch: &Sketch, opts: &QueryOptions) -> Result<QuerySet> {
     check_options(opts)?;
-    let file = sketch.path.display().to_string();
     let mut out = QuerySet::default();
     for q in &sketch.queries {
         let (spine, width) = match &q.kind {
             QueryKind::Path { spine, width } => (spine, *width),
             QueryKind::Region { .. } => {
                 out.notes.push(format!(
-                    "{file}: query {} is a filled region, left to fill and pattern",
+                    "query {} is a filled region, left to fill and pattern",
                     q.id
                 ));
                 continue;
             }
         };
         if !width.is_finite() || width <= 0.0 || !path_is_finite(spine) {
-            return Err(Error::invalid(
-                &sketch.path,
-                format!("query {} has a non-finite coordinate or width", q.id),
-            ));
+            return Err(Error::invalid(format!(
+                "query {} has a non-finite coordinate or width",
+                q.id
+            )));
         }
         let spacing = width * opts.spacing_in_widths;
         for (k, poly) in flatten_subpaths(spine, spacing, opts)
             .into_iter()
             .enumerate()
         {
-            let what = format!("{file}: query {} subpath {k}", q.id);
+            let what = format!("query {} subpath {k}", q.id);
             if !touches(&poly, sketch.view_box.inflate(width, width)) {
                 out.warnings
                     .push(format!("{what} lies outside the viewBox and is skipped"));
@@ -174,7 +173,7 @@ fn check_options(opts: &QueryOptions) -> Result<()> {
     }
     if opts.max_samples < 2 {
         return Err(Error::Option {
-            name: "max-samples",
+            name: "max_samples",
             reason: "a spine needs at least 2 samples".into(),
         });
     }
@@ -387,13 +386,12 @@ fn unit_tangent(prev: Vec2, next: Vec2) -> Vec2 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::path::Path;
 
     fn sketch(body: &str) -> Sketch {
         let svg = format!(
             r##"<svg xmlns="http://www.w3.org/2000/svg" width="200" height="200" viewBox="0 0 200 200">{body}</svg>"##
         );
-        crate::read::sketch::parse(Path::new("s.svg"), svg.as_bytes()).expect("parses")
+        crate::read::sketch::parse(svg.as_bytes()).expect("parses")
     }
 
     #[test]
@@ -473,7 +471,7 @@ mod tests {
         assert!(set
             .warnings
             .iter()
-            .all(|w| w.starts_with("s.svg: query multi subpath")));
+            .all(|w| w.starts_with("query multi subpath")));
     }
 
     #[test]
@@ -560,7 +558,7 @@ mod tests {
     }
 
     #[test]
-    fn non_finite_coordinates_name_the_file() {
+    fn non_finite_coordinates_name_the_query() {
         let mut s =
             sketch(r##"<path d="M10 10 H110" stroke="#000" stroke-width="10" fill="none"/>"##);
         if let QueryKind::Path { spine, .. } = &mut s.queries[0].kind {
@@ -569,6 +567,6 @@ mod tests {
         let e = spines(&s, &QueryOptions::default())
             .unwrap_err()
             .to_string();
-        assert!(e.starts_with("s.svg: "), "{e}");
+        assert!(e.starts_with("query q-1 has a non-finite"), "{e}");
     }
 }

@@ -586,18 +586,6 @@ pub fn upsample(style: &BrushStyle, field: &Field) -> Field {
     }
 }
 
-/// The whole §5.4 pipeline from an initialized coarsest field: correct,
-/// upsample, correct, … up to the finest level of the style.
-pub fn synthesize(style: &BrushStyle, init: Field, opts: &SynthOptions) -> Field {
-    let mut levels = synthesize_levels(style, init, opts);
-    levels.pop().unwrap_or_else(|| Field {
-        level: 0,
-        coords: Grid::new(0, 0, None),
-        orient: Grid::new(0, 0, [0.0; 2]),
-        seam: Grid::new(0, 0, false),
-    })
-}
-
 /// [`synthesize`], keeping the corrected field of every level visited,
 /// coarse to fine.
 pub fn synthesize_levels(style: &BrushStyle, init: Field, opts: &SynthOptions) -> Vec<Field> {

@@ -70,6 +70,7 @@ pub struct Synthesis {
     /// One SDF per tile layer, target pixels, negative inside.
     pub layers: Vec<Grid<f32>>,
     /// Voted colour (0..1 RGB).
+    #[cfg_attr(not(test), allow(dead_code))] // read by the tests
     pub colour: Grid<[f32; 3]>,
     /// Eq. 6 energy ([`interior_energy`]) per level used (coarse first): of the
     /// level's initial matches, then after each M-step, per neighbourhood
@@ -85,6 +86,7 @@ struct State {
 
 /// Synthesizes a `width`×`height` image from `tile` (finest level), whose
 /// texture follows `direction` (a unit vector per target pixel).
+#[cfg(test)]
 pub fn synthesize(tile: &Tile, direction: &DirectionGrid, params: &EmParams) -> Synthesis {
     synthesize_in(tile, direction, None, params)
 }
@@ -95,6 +97,7 @@ pub fn synthesize(tile: &Tile, direction: &DirectionGrid, params: &EmParams) -> 
 ///
 /// Prepares the tile on every call; to fill several regions from one tile
 /// prepare it once ([`Prepared::new`]) and call [`Prepared::synthesize`].
+#[cfg(test)]
 pub fn synthesize_in(
     tile: &Tile,
     direction: &DirectionGrid,

@@ -33,6 +33,7 @@
 //! Not done: the colour warp by the level-set deformation field (§2, last
 //! paragraph), replaced by voting.
 
+#[cfg(test)]
 pub mod continuity;
 pub mod em;
 pub mod levelset;
@@ -45,53 +46,66 @@ pub mod tile;
 use crate::error::{Error, Result};
 use crate::field::diffusion::constant_field;
 use crate::raster::{Grid, Sdf};
-use crate::read::sketch::{self, QueryKind, Sketch};
+use crate::read::sketch::{Query, QueryKind, Sketch};
 use crate::read::style::{self, DirectionToml, StyleKind};
 use crate::svg_out::{decimals_for, Document, FillRule, Group, Shape};
 use crate::trace::{trace_sdf, TraceOptions};
 use em::EmParams;
 use kurbo::{BezPath, PathEl, Point, Shape as _};
 use region::Region;
-use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use tile::{SourceDirection, Tile};
 
-/// Options of `flourish fill`.
+/// Options of [`crate::fill()`].
 #[derive(Clone, Debug)]
 pub struct FillOptions {
-    /// `--style`: a folder holding `style.toml`, or a name in `styles_dir`.
-    pub style: String,
-    /// `--styles DIR`: where bare style names are looked up.
-    pub styles_dir: PathBuf,
-    /// `--seed`: seeds every random choice.
+    /// Seeds every random choice (default 0).
     pub seed: u64,
-    /// `--direction D.svg`: open paths that comb every region's direction.
-    pub direction: Option<PathBuf>,
-    /// `--resolution PX`: tile raster size (longest side), overriding the
-    /// style's `resolution`.
-    pub resolution: Option<u32>,
-    /// Tracing tolerance, synthesis pixels (default 0.25).
+    /// A sketch whose open stroked paths comb the direction of every
+    /// region, as the paths inside a region comb its own (Brushables §3.2;
+    /// default `None`).
+    pub direction: Option<Sketch>,
+    /// Largest distance of the traced curves from the synthesized outline,
+    /// in synthesis pixels (0.01..=100; default 0.25).
     pub tolerance: f64,
 }
 
 impl Default for FillOptions {
     fn default() -> Self {
         FillOptions {
-            style: "knot".into(),
-            styles_dir: style::default_styles_dir(),
             seed: 0,
             direction: None,
-            resolution: None,
             tolerance: 0.25,
         }
+    }
+}
+
+impl FillOptions {
+    /// Checks every value's range, and that a direction sketch combs.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.tolerance.is_finite() && (0.01..=100.0).contains(&self.tolerance)) {
+            return Err(Error::Option {
+                name: "tolerance",
+                reason: format!("{} px is not in 0.01..=100", self.tolerance),
+            });
+        }
+        if self
+            .direction
+            .as_ref()
+            .is_some_and(|d| combing_strokes(d).is_empty())
+        {
+            return Err(Error::Option {
+                name: "direction",
+                reason: "no open stroked path to comb with".into(),
+            });
+        }
+        Ok(())
     }
 }
 
 /// A loaded fill style.
 #[derive(Clone, Debug)]
 pub struct FillStyle {
-    /// The tile file.
-    pub tile_path: PathBuf,
     /// The tile at synthesis resolution.
     pub tile: Tile,
     /// Synthesis parameters (seed set per region).
@@ -117,17 +131,15 @@ impl FillStyle {
     pub fn load(dir: &Path, resolution: Option<u32>) -> Result<FillStyle> {
         let toml = style::load(dir)?;
         toml.expect_kind(dir, StyleKind::Fill)?;
-        let ex = toml
-            .exemplar
-            .first()
-            .ok_or_else(|| Error::invalid(dir.join(style::STYLE_FILE), "exemplar: missing"))?;
-        let tile_path = dir.join(&ex.file);
+        let ex = toml.exemplar.first().ok_or_else(|| {
+            Error::invalid("exemplar: missing").in_file(dir.join(style::STYLE_FILE))
+        })?;
         let source = match &toml.direction {
             Some(DirectionToml::Vector(v)) => SourceDirection::Constant(*v),
             _ => SourceDirection::Etf,
         };
         let tile = Tile::load(
-            &tile_path,
+            &dir.join(&ex.file),
             resolution.or(toml.resolution).unwrap_or(96),
             source,
         )?;
@@ -152,7 +164,6 @@ impl FillStyle {
             ..defaults
         };
         Ok(FillStyle {
-            tile_path,
             tile,
             params,
             scale: toml.scale.unwrap_or(1.0),
@@ -166,8 +177,10 @@ impl FillStyle {
     }
 }
 
-/// One filled region of the output.
+/// One filled region of the output: what was synthesized and traced, with
+/// the figures the tests measure it by.
 #[derive(Clone, Debug)]
+#[cfg_attr(not(test), allow(dead_code))] // the grids and figures are read by the tests
 pub struct RegionFill {
     /// The query's id.
     pub id: String,
@@ -187,6 +200,7 @@ pub struct RegionFill {
 
 impl RegionFill {
     /// Fraction of the region's pixels under ink (bottom layer).
+    #[cfg(test)]
     pub fn ink_fraction(&self) -> f64 {
         let Some(l) = self.layers.first() else {
             return 0.0;
@@ -243,21 +257,26 @@ impl FillOutput {
     }
 }
 
-/// Runs `flourish fill` on a sketch file.
-pub fn run(opts: &FillOptions, sketch: &Path) -> Result<Document> {
-    let sk = sketch::load(sketch)?;
-    Ok(fill_sketch(opts, &sk)?.to_document())
+/// The open stroked paths of a sketch as polylines with their widths.
+fn combing_strokes(sk: &Sketch) -> Vec<(Vec<Point>, f64)> {
+    sk.queries
+        .iter()
+        .filter_map(|q| match &q.kind {
+            QueryKind::Path { spine, width } => Some((polyline(spine), *width)),
+            QueryKind::Region { .. } => None,
+        })
+        .collect()
 }
 
-/// Fills every region query of a parsed sketch; open paths inside a region
-/// (and those of `opts.direction`) comb its direction field.
-pub fn fill_sketch(opts: &FillOptions, sk: &Sketch) -> Result<FillOutput> {
-    if !(opts.tolerance.is_finite() && (0.01..=100.0).contains(&opts.tolerance)) {
-        return Err(Error::Option {
-            name: "--tolerance",
-            reason: format!("{} px is not in 0.01..=100", opts.tolerance),
-        });
-    }
+/// Fills every region query of a parsed sketch, each with the style
+/// `style_of` gives it (with its name, for the notes); open paths inside a
+/// region (and those of `opts.direction`) comb its direction field.
+pub fn fill_sketch<'s>(
+    sk: &Sketch,
+    style_of: impl Fn(&Query) -> Result<(&'s str, &'s FillStyle)>,
+    opts: &FillOptions,
+) -> Result<FillOutput> {
+    opts.validate()?;
     let mut strokes: Vec<(Vec<Point>, f64)> = Vec::new();
     let mut regions = Vec::new();
     for q in &sk.queries {
@@ -267,45 +286,36 @@ pub fn fill_sketch(opts: &FillOptions, sk: &Sketch) -> Result<FillOutput> {
         }
     }
     if regions.is_empty() {
-        return Err(Error::invalid(
-            &sk.path,
-            "no filled closed shape to fill: the sketch has only open paths (give the shapes a fill)",
-        ));
+        return Err(Error::invalid("no filled closed shape to fill: the sketch has only open paths (give the shapes a fill)"));
     }
-    let mut global: Vec<(Vec<Point>, f64)> = Vec::new();
-    if let Some(d) = &opts.direction {
-        let ds = sketch::load(d)?;
-        for q in &ds.queries {
-            if let QueryKind::Path { spine, width } = &q.kind {
-                global.push((polyline(spine), *width));
-            }
-        }
-        if global.is_empty() {
-            return Err(Error::invalid(d, "no open stroked path to comb with"));
-        }
-    }
-    // Each style is loaded and its tile prepared for synthesis once per
-    // sketch, then shared by every region that uses it.
-    let mut styles: BTreeMap<String, (FillStyle, em::Prepared)> = BTreeMap::new();
+    let global = opts
+        .direction
+        .as_ref()
+        .map(combing_strokes)
+        .unwrap_or_default();
+    // Each style's tile is prepared for synthesis once per sketch, then
+    // shared by every region that uses it.
+    let mut prepared_styles: Vec<(&FillStyle, em::Prepared)> = Vec::new();
     let mut out = Vec::new();
     let mut notes = Vec::new();
     let mut max_ppu = 1.0f64;
     for (qi, (q, outline, rule)) in regions.into_iter().enumerate() {
-        let name = q.style.clone().unwrap_or_else(|| opts.style.clone());
-        if !styles.contains_key(&name) {
-            let dir = match &q.style {
-                Some(ds) => style::resolve_data_style(&sk.path, &q.id, ds, &opts.styles_dir)?,
-                None => style::resolve(&name, &opts.styles_dir)?,
-            };
-            let st = FillStyle::load(&dir, opts.resolution)?;
-            let prepared = em::Prepared::new(&st.tile, &st.params);
-            styles.insert(name.clone(), (st, prepared));
-        }
-        let (st, prepared) = &styles[&name];
+        let (name, st) = style_of(q)?;
+        let k = match prepared_styles
+            .iter()
+            .position(|(s, _)| std::ptr::eq(*s, st))
+        {
+            Some(k) => k,
+            None => {
+                prepared_styles.push((st, em::Prepared::new(&st.tile, &st.params)));
+                prepared_styles.len() - 1
+            }
+        };
+        let prepared = &prepared_styles[k].1;
         let ppu = st.px_per_unit();
         max_ppu = max_ppu.max(ppu);
         let margin = st.params.radius + 2;
-        let mut region = Region::rasterize(&sk.path, &q.id, outline, rule, ppu, margin)?;
+        let mut region = Region::rasterize(&q.id, outline, rule, ppu, margin)?;
         if let Flow::Fixed(d) = st.flow {
             region.direction = constant_field(region.width(), region.height(), d);
         }
@@ -399,3 +409,6 @@ fn mostly_inside(outline: &BezPath, rule: FillRule, pts: &[Point]) -> bool {
         .count();
     !pts.is_empty() && 2 * inside > pts.len()
 }
+
+#[cfg(test)]
+mod tests;

@@ -252,6 +252,7 @@ pub struct ShapeTerm<'a> {
 
 impl<'a> Problem<'a> {
     /// Sets up a search (pads the source, builds the gather offsets).
+    #[cfg(test)]
     pub fn new(
         source: &'a Channels,
         source_angle: &'a Grid<f32>,
@@ -541,6 +542,7 @@ impl<'a> Problem<'a> {
 
     /// The exact nearest tile pixel of centre `(qx, qy)` by exhaustive
     /// search (first minimum in row-major order): the reference for tests.
+    #[cfg(test)]
     pub fn brute_force(&self, qx: usize, qy: usize) -> Match {
         let mut buf = Vec::new();
         self.target_patch(qx, qy, &mut buf);
@@ -559,6 +561,7 @@ impl<'a> Problem<'a> {
 }
 
 /// A field of matches seeded at random (hash of seed and centre).
+#[cfg(test)]
 pub fn random_nnf(
     width: usize,
     height: usize,

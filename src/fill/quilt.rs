@@ -374,6 +374,7 @@ pub fn min_vertical_cut(err: &[f32], w: usize, h: usize) -> Vec<usize> {
 }
 
 /// The channels of a quilted map.
+#[cfg(test)]
 pub fn apply(source: &Channels, map: &Grid<(u32, u32)>) -> Channels {
     let mut data = Vec::with_capacity(map.data().len() * source.depth);
     for &(x, y) in map.data() {

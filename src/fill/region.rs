@@ -9,7 +9,6 @@ use crate::raster::vector::flatten_segments;
 use crate::raster::{Grid, Sdf};
 use crate::svg_out::FillRule;
 use kurbo::{Affine, BezPath, Line, Point, Shape as _};
-use std::path::Path;
 
 /// Largest synthesis grid for one region, pixels per side.
 pub const MAX_FILL_SIDE: u64 = 4096;
@@ -27,8 +26,6 @@ pub struct Region {
     pub sdf: Sdf,
     /// Target direction per pixel (unit, pixel axes).
     pub direction: DirectionGrid,
-    /// The outline flattened to segments, pixel coordinates.
-    pub segments: Vec<Line>,
     /// Number of inside pixels.
     pub area: usize,
 }
@@ -38,7 +35,6 @@ impl Region {
     /// pixels around its bounding box. Fails (naming `file` and `id`) when
     /// the grid is over the size limit or no pixel centre is inside.
     pub fn rasterize(
-        file: &Path,
         id: &str,
         outline: &BezPath,
         fill_rule: FillRule,
@@ -47,24 +43,19 @@ impl Region {
     ) -> Result<Region> {
         let bb = outline.bounding_box();
         if !(bb.width().is_finite() && bb.height().is_finite()) {
-            return Err(Error::invalid(file, format!("{id}: outline is not finite")));
+            return Err(Error::invalid(format!("{id}: outline is not finite")));
         }
         let (w, h) = (
             (bb.width() * px_per_unit).ceil() + 2.0 * margin as f64,
             (bb.height() * px_per_unit).ceil() + 2.0 * margin as f64,
         );
         let (w, h) = (w.max(1.0) as u64, h.max(1.0) as u64);
-        io::check_canvas(file, w, h)?;
+        io::check_canvas(w, h)?;
         if w > MAX_FILL_SIDE || h > MAX_FILL_SIDE || w * h > MAX_FILL_PIXELS {
-            return Err(Error::TooLarge {
-                path: file.to_path_buf(),
-                width: w,
-                height: h,
-                limit: format!(
+            return Err(Error::TooLarge { width: w, height: h, limit: format!(
                     "region {id}: {MAX_FILL_SIDE} px per side, {} Mpx in all for a fill; lower the style's resolution or raise its scale",
                     MAX_FILL_PIXELS >> 20
-                ),
-            });
+                ) });
         }
         let (w, h) = (w as usize, h as usize);
         // Grid pixel (0, 0) is at the box corner minus the margin.
@@ -78,10 +69,7 @@ impl Region {
         let mask = scan_inside(w, h, &segments, fill_rule);
         let area = mask.data().iter().filter(|&&b| b).count();
         if area == 0 {
-            return Err(Error::invalid(
-                file,
-                format!("{id}: region is smaller than one tile pixel; draw it larger or raise the style's resolution"),
-            ));
+            return Err(Error::invalid(format!("{id}: region is smaller than one tile pixel; draw it larger or raise the style's resolution")));
         }
         let sdf = Sdf::from_segments(&mask, &segments, to_px.inverse());
         // Boundary flow, diffused over a quarter of the region's smaller side.
@@ -95,7 +83,6 @@ impl Region {
             mask,
             sdf,
             direction,
-            segments,
             area,
         })
     }
@@ -203,8 +190,7 @@ mod tests {
         // Inner circle drawn the other way round: a hole under nonzero.
         let inner = Circle::new((50.0, 50.0), 15.0).to_path(0.01);
         p.extend(inner.reverse_subpaths());
-        let r =
-            Region::rasterize(Path::new("s.svg"), "q-1", &p, FillRule::NonZero, 1.0, 4).unwrap();
+        let r = Region::rasterize("q-1", &p, FillRule::NonZero, 1.0, 4).unwrap();
         // Grid origin is (6, 6) in sketch units.
         let at = |x: f64, y: f64| r.mask.get((x - 6.0) as usize, (y - 6.0) as usize);
         assert!(at(50.0, 20.0));
@@ -236,7 +222,7 @@ mod tests {
         // A 100×60 rectangle: its boundary flow circles the centre, so the
         // bottom-left corner runs roughly opposite to the top-right one.
         let p = Rect::new(0.0, 0.0, 100.0, 60.0).to_path(0.1);
-        let r = Region::rasterize(Path::new("s.svg"), "q", &p, FillRule::NonZero, 1.0, 2).unwrap();
+        let r = Region::rasterize("q", &p, FillRule::NonZero, 1.0, 2).unwrap();
         let (a, b) = (r.direction.get(5, 55), r.direction.get(95, 5));
         assert!(a[0] * b[0] + a[1] * b[1] < 0.0, "{a:?} {b:?}");
         // A thin stroke rising at 30° across the middle (grid px = units
@@ -268,7 +254,7 @@ mod tests {
     #[test]
     fn a_speck_is_refused() {
         let p = Circle::new((5.0, 5.0), 0.2).to_path(0.01);
-        let e = Region::rasterize(Path::new("s.svg"), "dot", &p, FillRule::NonZero, 1.0, 0)
+        let e = Region::rasterize("dot", &p, FillRule::NonZero, 1.0, 0)
             .unwrap_err()
             .to_string();
         assert!(e.contains("smaller than one tile pixel"), "{e}");

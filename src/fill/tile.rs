@@ -10,7 +10,7 @@
 use crate::error::{Error, Result};
 use crate::field::{edge_tangent_flow, DirectionGrid, EtfOptions};
 use crate::raster::{Grid, Sdf};
-use crate::read::ink::{self, InputOptions};
+use crate::read::ink::{self, ImageOptions};
 use crate::svg_out::Color;
 use kurbo::{Affine, Vec2};
 use std::path::Path;
@@ -129,21 +129,21 @@ impl Tile {
     pub fn load(path: &Path, resolution: u32, dir: SourceDirection) -> Result<Tile> {
         let ink = ink::load(
             path,
-            &InputOptions {
+            &ImageOptions {
                 resolution,
                 invert: false,
                 layers: true,
             },
         )?;
         let first = ink.layers.first().ok_or_else(|| {
-            Error::invalid(path, "tile has no ink: draw the pattern in a fill colour")
+            Error::invalid("tile has no ink: draw the pattern in a fill colour").in_file(path)
         })?;
         let (w, h) = (first.sdf.width(), first.sdf.height());
         if w < 8 || h < 8 {
-            return Err(Error::invalid(
-                path,
-                format!("tile is {w}×{h} px; it needs at least 8×8 px"),
-            ));
+            return Err(
+                Error::invalid(format!("tile is {w}×{h} px; it needs at least 8×8 px"))
+                    .in_file(path),
+            );
         }
         let units_per_px = 1.0 / first.sdf.px_per_unit();
         let layers: Vec<TileLayer> = ink
@@ -156,16 +156,13 @@ impl Tile {
             .collect();
         let ink_px = layers[0].sdf.data().iter().filter(|&&d| d < 0.0).count();
         if ink_px == 0 {
-            return Err(Error::invalid(
-                path,
-                "tile has no ink at this resolution: draw the pattern larger or raise the style's resolution",
-            ));
+            return Err(Error::invalid("tile has no ink at this resolution: draw the pattern larger or raise the style's resolution").in_file(path));
         }
         if ink_px == w * h {
             return Err(Error::invalid(
-                path,
                 "tile is ink everywhere: leave paper between the motifs (no background rectangle)",
-            ));
+            )
+            .in_file(path));
         }
         Ok(Tile::assemble(layers, dir, units_per_px))
     }

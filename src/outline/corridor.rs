@@ -23,6 +23,7 @@
 //! mixed cell lies within the tolerance of it.
 
 use super::paths::Bitmap;
+#[cfg(test)]
 use crate::raster::Coverage;
 use kurbo::Point;
 use std::borrow::Cow;
@@ -39,6 +40,7 @@ pub struct Corridor<'a> {
 
 impl Corridor<'static> {
     /// The corridor of binary coverage `cov` (ink where coverage ≥ ½).
+    #[cfg(test)]
     pub fn new(cov: &Coverage) -> Self {
         Corridor {
             bits: Cow::Owned(Bitmap::from_coverage(cov)),

@@ -59,11 +59,12 @@
 
 use super::line_ends;
 use crate::outline::paths::{self, Bitmap};
-pub use crate::outline::polygon::STRAIGHT_TOLERANCE;
 use crate::outline::polygon::{optimal_polygon, possible_segments, straight_runs};
 use crate::outline::vertices::{adjust_vertices, edge_lines};
 use crate::raster::contour;
-use crate::raster::{Coverage, Grid, Sdf};
+#[cfg(test)]
+use crate::raster::Coverage;
+use crate::raster::{Grid, Sdf};
 use kurbo::{CubicBez, ParamCurve, ParamCurveDeriv, Point, Vec2};
 use rayon::prelude::*;
 
@@ -103,6 +104,7 @@ pub struct SmoothLoop {
 /// tangents and corners: what `flourish trace` fits Béziers to directly.
 /// Outer loops are counter-clockwise in the y-down sense of
 /// [`crate::raster::contour::Contour::signed_area`] > 0, holes the other way.
+#[cfg(test)]
 pub fn smooth_loops(cov: &Coverage) -> Vec<SmoothLoop> {
     bitmap_loops(&Bitmap::from_coverage(cov))
 }
@@ -119,6 +121,7 @@ pub fn bitmap_loops(bits: &Bitmap) -> Vec<SmoothLoop> {
 /// The smoothed outline of binary coverage `cov`: closed polylines in pixel
 /// coordinates (outer loops counter-clockwise in the y-down sense of
 /// [`crate::raster::contour::Contour::signed_area`] > 0, holes the other way).
+#[cfg(test)]
 pub fn smooth_outline(cov: &Coverage) -> Vec<Vec<Point>> {
     smooth_loops(cov).into_iter().map(|l| l.points).collect()
 }
@@ -516,12 +519,6 @@ fn cubic_steps(c: &CubicBez) -> usize {
     let dd2 = ((c.p3 - c.p2) - (c.p2 - c.p1)).hypot();
     let m = 6.0 * dd1.max(dd2);
     ((m / (8.0 * FLATTEN)).sqrt().ceil() as usize).clamp(1, 64)
-}
-
-/// The SDF of binary coverage read as its smoothed outline: distances to
-/// the curves of [`smooth_outline`], inside taken from the same curves.
-pub fn sdf(cov: &Coverage, to_user: kurbo::Affine) -> Sdf {
-    bitmap_sdf(&Bitmap::from_coverage(cov), to_user)
 }
 
 /// [`sdf`] of a bitmap's ink.

@@ -198,8 +198,6 @@ pub struct Distribution {
     pub shift: Vec<Option<Vec2>>,
     /// Mean neighbour distance, reference units.
     pub spacing: f64,
-    /// The length (1-D) the elements cover: N·spacing.
-    pub length: f64,
     /// Distance between rows when a row example fills a region: the mean
     /// height of the elements across the row plus half a spacing. Equal to
     /// `spacing` for a field.
@@ -273,7 +271,6 @@ impl Distribution {
         Distribution {
             dim,
             pitch,
-            length: n as f64 * spacing,
             centres,
             graph,
             shift,

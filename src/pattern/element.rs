@@ -212,24 +212,22 @@ pub fn load_example(
     fit: FitPoints,
     scale: f64,
 ) -> Result<Vec<ExampleStroke>> {
-    let tree = crate::read::svg::parse_svg(path, data)?;
+    let tree = crate::read::svg::parse_svg(data).map_err(|e| e.in_file(path))?;
     let h = (scale / 16.0).max(1e-3);
     let mut strokes = Vec::new();
     collect(tree.root(), fit, h, &mut strokes);
     if strokes.is_empty() {
-        return Err(Error::invalid(
-            path,
-            "the pattern example has no visible strokes or filled shapes",
-        ));
+        return Err(
+            Error::invalid("the pattern example has no visible strokes or filled shapes")
+                .in_file(path),
+        );
     }
     if strokes.len() > MAX_EXAMPLE_STROKES {
-        return Err(Error::invalid(
-            path,
-            format!(
-                "the pattern example has {} strokes, more than the limit of {MAX_EXAMPLE_STROKES}",
-                strokes.len()
-            ),
-        ));
+        return Err(Error::invalid(format!(
+            "the pattern example has {} strokes, more than the limit of {MAX_EXAMPLE_STROKES}",
+            strokes.len()
+        ))
+        .in_file(path));
     }
     Ok(strokes)
 }

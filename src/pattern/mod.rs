@@ -25,7 +25,7 @@ pub mod seeds;
 pub mod synth;
 
 use crate::error::{Error, Result};
-use crate::read::sketch::{QueryKind, Sketch};
+use crate::read::sketch::{Query, QueryKind, Sketch};
 use crate::read::style::{self, FitPoints, StyleKind};
 use crate::svg_out::{Document, Group, Shape};
 use distribution::{Dim, Distribution, Graph};
@@ -33,42 +33,46 @@ use element::{Element, ExampleStroke};
 use kurbo::{Affine, Point, Rect, Shape as _, Vec2};
 use rayon::prelude::*;
 use seeds::{Polyline, Region};
-use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
 use synth::{Placed, Reference, Target};
 
 /// Default largest number of elements synthesized for one query.
 pub const DEFAULT_MAX_ELEMENTS: usize = 50_000;
 
-/// Options of `flourish pattern`.
+/// Options of [`crate::pattern()`].
 #[derive(Clone, Debug)]
 pub struct PatternOptions {
-    /// `--style`: a folder holding `style.toml`, or a style name looked up
-    /// in `styles_dir`. Default: `"stipple"`.
-    pub style: String,
-    /// `--styles DIR`: where bare style names are looked up. Default: the
-    /// `styles/` folder shipped with the crate.
-    pub styles_dir: PathBuf,
-    /// `--seed`: seeds every random choice. Default 0.
+    /// Seeds every random choice (default 0).
     pub seed: u64,
-    /// `--variation`: amount of the §3.3 variation post-process, 0..=1
-    /// (0: elements exactly on the Lloyd seeds, as matched). Default 0.
+    /// Amount of the variation post-process (Barla et al. §3.3), 0..=1: 0
+    /// puts the elements exactly on the Lloyd seeds, as matched (default 0).
     pub variation: f64,
-    /// Largest number of elements one query may ask for; more is an error.
-    /// Default [`DEFAULT_MAX_ELEMENTS`].
+    /// Largest number of elements one query may ask for; more is an error
+    /// (default 50 000).
     pub max_elements: usize,
 }
 
 impl Default for PatternOptions {
     fn default() -> Self {
         PatternOptions {
-            style: "stipple".into(),
-            styles_dir: style::default_styles_dir(),
             seed: 0,
             variation: 0.0,
             max_elements: DEFAULT_MAX_ELEMENTS,
         }
+    }
+}
+
+impl PatternOptions {
+    /// Checks every value's range.
+    pub fn validate(&self) -> Result<()> {
+        if !(self.variation.is_finite() && (0.0..=1.0).contains(&self.variation)) {
+            return Err(Error::Option {
+                name: "variation",
+                reason: format!("{} is not in 0..=1", self.variation),
+            });
+        }
+        Ok(())
     }
 }
 
@@ -87,32 +91,17 @@ pub struct PatternParams {
     pub lloyd_iterations: usize,
 }
 
-impl PatternParams {
-    /// Parameters with the defaults for everything but ε.
-    pub fn with_scale(scale: f64) -> PatternParams {
-        PatternParams {
-            scale,
-            rings: 2,
-            fit: FitPoints::Contour,
-            dimension: None,
-            lloyd_iterations: 60,
-        }
-    }
-}
+impl PatternParams {}
 
 /// An analysed pattern style: the example's strokes in the reference frame
 /// and the reference (elements, distribution, neighbourhoods).
 #[derive(Clone, Debug)]
 pub struct PatternStyle {
-    /// The example file (for messages).
-    pub example: PathBuf,
     /// Analysis parameters.
     pub params: PatternParams,
     /// The example's strokes, moved rigidly into the reference frame
     /// (centred; a row turned to run along +x).
     pub strokes: Vec<ExampleStroke>,
-    /// The rigid transform from the example's user units to the frame.
-    pub frame: Affine,
     /// Elements, distribution, neighbourhoods and measures.
     pub reference: Reference,
 }
@@ -124,10 +113,9 @@ impl PatternStyle {
         toml.expect_kind(dir, StyleKind::Pattern)?;
         let toml_path = dir.join(style::STYLE_FILE);
         let (Some(scale), Some(ex)) = (toml.scale, toml.exemplar.first()) else {
-            return Err(Error::invalid(
-                toml_path,
-                "a pattern style needs scale and one exemplar",
-            ));
+            return Err(
+                Error::invalid("a pattern style needs scale and one exemplar").in_file(toml_path),
+            );
         };
         let params = PatternParams {
             scale,
@@ -146,10 +134,11 @@ impl PatternStyle {
     /// Analyses example SVG bytes (§2); `path` names the file in errors.
     pub fn from_example(path: &Path, data: &[u8], params: PatternParams) -> Result<PatternStyle> {
         if !(params.scale.is_finite() && params.scale > 0.0) {
-            return Err(Error::invalid(
-                path,
-                format!("scale must be a positive number, got {}", params.scale),
-            ));
+            return Err(Error::invalid(format!(
+                "scale must be a positive number, got {}",
+                params.scale
+            ))
+            .in_file(path));
         }
         let mut strokes = element::load_example(path, data, params.fit, params.scale)?;
         let clusters = cluster::cluster(&strokes, params.scale);
@@ -198,15 +187,14 @@ impl PatternStyle {
         );
         let reference = Reference::new(elements, dist, params.rings);
         Ok(PatternStyle {
-            example: path.to_path_buf(),
             params,
             strokes,
-            frame,
             reference,
         })
     }
 
     /// The reference elements.
+    #[cfg(test)]
     pub fn elements(&self) -> &[Element] {
         &self.reference.elements
     }
@@ -299,58 +287,36 @@ impl PatternOutput {
     }
 }
 
-/// Runs `flourish pattern` on the sketch file: loads the sketch and its
-/// styles, synthesizes, and returns the output document.
-pub fn run(opts: &PatternOptions, sketch: &Path) -> Result<Document> {
-    let sk = crate::read::sketch::load(sketch)?;
-    Ok(synthesize_sketch(opts, &sk)?.to_document())
-}
-
-/// Synthesizes the patterns for every query of a parsed sketch. Queries
-/// run in parallel; the result does not depend on the thread count.
-pub fn synthesize_sketch(opts: &PatternOptions, sk: &Sketch) -> Result<PatternOutput> {
-    if !(0.0..=1.0).contains(&opts.variation) {
-        return Err(Error::Option {
-            name: "--variation",
-            reason: format!("must be within 0..1, got {}", opts.variation),
-        });
-    }
+/// Synthesizes the patterns for every query of a parsed sketch, each with
+/// the style `style_of` gives it. Queries run in parallel; the result does
+/// not depend on the thread count.
+pub fn synthesize_sketch(
+    sk: &Sketch,
+    style_of: impl Fn(&Query) -> Result<Arc<PatternStyle>> + Sync,
+    opts: &PatternOptions,
+) -> Result<PatternOutput> {
+    opts.validate()?;
     if sk.queries.is_empty() {
         return Err(Error::invalid(
-            &sk.path,
             "no stroked path or filled shape to decorate",
         ));
-    }
-    let mut styles: BTreeMap<&str, Arc<PatternStyle>> = BTreeMap::new();
-    for q in &sk.queries {
-        let name = q.style.as_deref().unwrap_or(&opts.style);
-        if !styles.contains_key(name) {
-            let dir = match &q.style {
-                Some(ds) => style::resolve_data_style(&sk.path, &q.id, ds, &opts.styles_dir)?,
-                None => style::resolve(name, &opts.styles_dir)?,
-            };
-            styles.insert(name, Arc::new(PatternStyle::load(&dir)?));
-        }
     }
     let queries = sk
         .queries
         .par_iter()
         .enumerate()
         .map(|(qi, q)| {
-            let name = q.style.as_deref().unwrap_or(&opts.style);
-            let style = styles.get(name).cloned().ok_or_else(|| {
-                Error::invalid(&sk.path, format!("{}: style {name} not loaded", q.id))
-            })?;
+            let style = style_of(q)?;
             let key = [opts.seed, qi as u64];
             let elements = match &q.kind {
                 QueryKind::Path { spine, width } => along_path(&style, spine, *width, opts, &key),
                 QueryKind::Region { outline, fill_rule } => {
                     let region = Region::new(outline, *fill_rule, 0.05)
-                        .map_err(|r| Error::invalid(&sk.path, format!("{}: {r}", q.id)))?;
+                        .map_err(|r| Error::invalid(format!("{}: {r}", q.id)))?;
                     in_region(&style, &region, outline, opts, &key)
                 }
             }
-            .map_err(|reason| Error::invalid(&sk.path, format!("{}: {reason}", q.id)))?;
+            .map_err(|reason| Error::invalid(format!("{}: {reason}", q.id)))?;
             Ok(QueryPattern {
                 id: q.id.clone(),
                 style,
@@ -539,3 +505,6 @@ fn place(style: &PatternStyle, p: Placed, at: Point, angle: f64) -> PlacedElemen
         centre: at,
     }
 }
+
+#[cfg(test)]
+mod tests;

@@ -373,6 +373,7 @@ pub struct Lloyd {
     /// Final seed positions, all inside the region.
     pub points: Vec<Point>,
     /// The CVT energy before each iteration's move (non-increasing).
+    #[cfg_attr(not(test), allow(dead_code))] // read by the tests
     pub energy: Vec<f64>,
 }
 

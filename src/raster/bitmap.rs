@@ -2,7 +2,9 @@
 //! raster is read as, and what the pixel outlines
 //! ([`crate::outline::paths`]) are walked on.
 
-use super::{Coverage, Grid};
+use super::Coverage;
+#[cfg(test)]
+use super::Grid;
 use rayon::prelude::*;
 
 /// A binary bitmap's ink flags with a one-pixel border of paper, so a
@@ -17,6 +19,7 @@ pub struct Bitmap {
 
 impl Bitmap {
     /// A `width` × `height` bitmap with ink where `ink(x, y)` (pixels).
+    #[cfg(test)]
     pub fn from_fn(width: usize, height: usize, mut ink: impl FnMut(usize, usize) -> bool) -> Self {
         let pw = width + 2;
         let mut flags = vec![0u8; pw * (height + 2)];
@@ -79,6 +82,7 @@ impl Bitmap {
     }
 
     /// Whether pixel (x, y) is ink; pixels outside the bitmap are paper.
+    #[cfg(test)]
     pub fn ink(&self, x: isize, y: isize) -> bool {
         let (w, h) = (self.width as isize, self.height as isize);
         if x < -1 || y < -1 || x > w || y > h {
@@ -100,6 +104,7 @@ impl Bitmap {
     }
 
     /// As coverage: 1 for ink, 0 for paper.
+    #[cfg(test)]
     pub fn to_coverage(&self) -> Coverage {
         Grid::from_fn(self.width, self.height, |x, y| {
             if self.ink(x as isize, y as isize) {

@@ -4,33 +4,28 @@
 //! [`Bitmap`]), or colours quantized into layers.
 
 use super::lighting::Lighting;
-use super::InputOptions;
+use super::ImageOptions;
 use crate::error::{Error, Result};
 use crate::io;
 use crate::outline::paths::Bitmap;
 use crate::raster::{Coverage, Grid};
 use crate::svg_out::Color;
 use rayon::prelude::*;
-use std::path::Path;
 
 /// Decodes raster bytes, refusing oversized images before decoding, and
 /// turns the picture as its Exif orientation says (as viewers show it).
-pub fn decode_raster(path: &Path, bytes: &[u8]) -> Result<image::DynamicImage> {
-    let bad = |e: &dyn std::fmt::Display| Error::Image {
-        path: path.to_path_buf(),
-        reason: e.to_string(),
-    };
+pub fn decode_raster(bytes: &[u8]) -> Result<image::DynamicImage> {
+    let bad = |e: &dyn std::fmt::Display| Error::Image(e.to_string());
     let reader = image::ImageReader::new(std::io::Cursor::new(bytes))
         .with_guessed_format()
         .map_err(|e| bad(&e))?;
     if reader.format().is_none() {
-        return Err(Error::Image {
-            path: path.to_path_buf(),
-            reason: "unknown format (expected PNG, JPEG, BMP, GIF, TIFF, WebP or SVG)".into(),
-        });
+        return Err(Error::Image(
+            "unknown format (expected PNG, JPEG, BMP, GIF, TIFF, WebP or SVG)".into(),
+        ));
     }
     let (w, h) = reader.into_dimensions().map_err(|e| bad(&e))?;
-    io::check_canvas(path, w as u64, h as u64)?;
+    io::check_canvas(w as u64, h as u64)?;
     let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
         .with_guessed_format()
         .map_err(|e| bad(&e))?;
@@ -70,11 +65,10 @@ pub(super) enum RasterCoverage {
 /// quantized colour layers; with the uneven light of a photo, when it was
 /// measured and divided out first.
 pub(super) fn raster_coverage(
-    path: &Path,
     bytes: &[u8],
-    opts: &InputOptions,
+    opts: &ImageOptions,
 ) -> Result<(RasterCoverage, Option<Lighting>)> {
-    let img = decode_raster(path, bytes)?;
+    let img = decode_raster(bytes)?;
     if let (image::DynamicImage::ImageLuma8(grey), false) = (&img, opts.layers) {
         let (w, h) = (grey.width() as usize, grey.height() as usize);
         // A photo's uneven light divided out first (see `lighting`).
@@ -111,7 +105,7 @@ pub(super) fn pixel_coverage(
     px: &[[u8; 4]],
     w: usize,
     h: usize,
-    opts: &InputOptions,
+    opts: &ImageOptions,
 ) -> RasterCoverage {
     let has_alpha = px.iter().any(|p| p[3] < 255);
     if opts.layers {

@@ -13,9 +13,8 @@
 //! (raster) is its own layer; layers are stacked bottom to top and each one
 //! extends under the layers above it, so stacked fills leave no seams.
 
-pub use super::image::decode_raster;
 use super::image::{pixel_coverage, raster_coverage, RasterCoverage};
-pub use super::InputOptions;
+pub use super::ImageOptions;
 use crate::error::{Error, Result};
 use crate::io;
 use crate::raster::vector::{overlapping, scan_inside, union_boundary, ExactCost, FlatShape};
@@ -55,12 +54,17 @@ pub struct Ink {
 }
 
 /// Reads `path` (raster or SVG, told apart by content) as ink.
-pub fn load(path: &Path, opts: &InputOptions) -> Result<Ink> {
+pub fn load(path: &Path, opts: &ImageOptions) -> Result<Ink> {
     let bytes = io::read_file(path)?;
-    if looks_like_svg(&bytes) {
-        load_svg(path, &bytes, opts)
+    read(&bytes, opts).map_err(|e| e.in_file(path))
+}
+
+/// Reads raster or SVG bytes (told apart by content) as ink.
+pub fn read(bytes: &[u8], opts: &ImageOptions) -> Result<Ink> {
+    if looks_like_svg(bytes) {
+        read_svg(bytes, opts)
     } else {
-        load_raster(path, &bytes, opts)
+        read_raster(bytes, opts)
     }
 }
 
@@ -144,12 +148,19 @@ impl OutlineLayer {
 
 /// Reads `path` for tracing: like [`load`], except that a raster comes back
 /// as the outlines of its layers.
-pub fn load_traceable(path: &Path, opts: &InputOptions) -> Result<Traceable> {
+#[cfg(test)]
+pub fn load_traceable(path: &Path, opts: &ImageOptions) -> Result<Traceable> {
     let bytes = io::read_file(path)?;
-    if looks_like_svg(&bytes) {
-        return load_svg(path, &bytes, opts).map(Traceable::Field);
+    read_traceable(&bytes, opts).map_err(|e| e.in_file(path))
+}
+
+/// Reads raster or SVG bytes for tracing: like [`read`], except that a
+/// raster comes back as the outlines of its layers.
+pub fn read_traceable(bytes: &[u8], opts: &ImageOptions) -> Result<Traceable> {
+    if looks_like_svg(bytes) {
+        return read_svg(bytes, opts).map(Traceable::Field);
     }
-    let (coverage, lighting) = raster_coverage(path, &bytes, opts)?;
+    let (coverage, lighting) = raster_coverage(bytes, opts)?;
     let (w, h, layers) = match coverage {
         RasterCoverage::Binary { w, h, color, bits } => (
             w,
@@ -176,10 +187,10 @@ pub fn load_traceable(path: &Path, opts: &InputOptions) -> Result<Traceable> {
     }))
 }
 
-/// Raster bytes (PNG, JPEG, …) read from `path` as ink, as [`load`] reads them.
-pub fn load_raster(path: &Path, bytes: &[u8], opts: &InputOptions) -> Result<Ink> {
+/// Raster bytes (PNG, JPEG, …) read as ink, as [`read`] reads them.
+pub fn read_raster(bytes: &[u8], opts: &ImageOptions) -> Result<Ink> {
     Ok(coverage_ink(
-        raster_coverage(path, bytes, opts)?.0,
+        raster_coverage(bytes, opts)?.0,
         Affine::IDENTITY,
     ))
 }
@@ -297,16 +308,15 @@ fn needs_render(group: &usvg::Group) -> bool {
 /// units. With `skip_id`, the top-level nodes are rendered one by one and
 /// the one with that id is left out.
 fn rendered_ink(
-    path: &Path,
     tree: &usvg::Tree,
-    opts: &InputOptions,
+    opts: &ImageOptions,
     skip_id: Option<&str>,
     (pw, ph): (usize, usize),
     canvas: tiny_skia::Transform,
     to_user: Affine,
 ) -> Result<Ink> {
     let mut pixmap = tiny_skia::Pixmap::new(pw as u32, ph as u32)
-        .ok_or_else(|| Error::invalid(path, "cannot allocate the render canvas"))?;
+        .ok_or_else(|| Error::invalid("cannot allocate the render canvas"))?;
     match skip_id {
         None => resvg::render(tree, canvas, &mut pixmap.as_mut()),
         Some(id) => {
@@ -343,41 +353,30 @@ struct LayerShapes<'a> {
     others: Vec<Vec<usize>>,
 }
 
-fn load_svg(path: &Path, bytes: &[u8], opts: &InputOptions) -> Result<Ink> {
+fn read_svg(bytes: &[u8], opts: &ImageOptions) -> Result<Ink> {
     // Inflated once for both the tree and the text check.
-    let bytes = crate::read::svg::inflate_svgz(path, bytes)?;
-    let tree = crate::read::svg::parse_svg(path, &bytes)?;
-    let mut ink = svg_ink(path, &tree, opts, None)?;
+    let bytes = crate::read::svg::inflate_svgz(bytes)?;
+    let tree = crate::read::svg::parse_svg(&bytes)?;
+    let mut ink = svg_ink(&tree, opts, None)?;
     ink.warnings
         .extend(crate::read::svg::text_left_out(&bytes).map(String::from));
     Ok(ink)
 }
 
-/// The ink of a parsed SVG `tree` (read from `path`, named in errors) as
-/// [`load`] reads SVG files; paths whose `id` is `skip_id` are left out
+/// The ink of a parsed SVG `tree` as [`read`] reads SVG; paths whose `id` is `skip_id` are left out
 /// (a brush exemplar's hand-drawn `id="spine"` is not ink).
-pub fn svg_ink(
-    path: &Path,
-    tree: &usvg::Tree,
-    opts: &InputOptions,
-    skip_id: Option<&str>,
-) -> Result<Ink> {
+pub fn svg_ink(tree: &usvg::Tree, opts: &ImageOptions, skip_id: Option<&str>) -> Result<Ink> {
     let size = tree.size();
     let (uw, uh) = (size.width() as f64, size.height() as f64);
-    if opts.resolution == 0 {
-        return Err(Error::Option {
-            name: "--resolution",
-            reason: "must be at least 1 px".into(),
-        });
-    }
+    opts.validate()?;
     let scale = opts.resolution as f64 / uw.max(uh);
     let (pw, ph) = ((uw * scale).ceil() as u64, (uh * scale).ceil() as u64);
-    io::check_canvas(path, pw.max(1), ph.max(1))?;
+    io::check_canvas(pw.max(1), ph.max(1))?;
     let (pw, ph) = (pw.max(1) as usize, ph.max(1) as usize);
     let canvas = tiny_skia::Transform::from_scale(scale as f32, scale as f32);
     let to_user = Affine::scale(1.0 / scale);
     if needs_render(tree.root()) {
-        return rendered_ink(path, tree, opts, skip_id, (pw, ph), canvas, to_user);
+        return rendered_ink(tree, opts, skip_id, (pw, ph), canvas, to_user);
     }
     let mut shapes = Vec::new();
     collect_shapes(tree.root(), canvas, skip_id, &mut shapes);
@@ -441,7 +440,7 @@ pub fn svg_ink(
     if !cost.affordable() {
         // Too dense to measure exactly: read the drawing's render, as a
         // raster's anti-aliased coverage is read.
-        let mut ink = rendered_ink(path, tree, opts, skip_id, (pw, ph), canvas, to_user)?;
+        let mut ink = rendered_ink(tree, opts, skip_id, (pw, ph), canvas, to_user)?;
         ink.notes.push(format!(
             "outlines too dense for exact distances ({} segments cross {} rows of pixels); read from the anti-aliased render",
             flat.iter().map(|f| f.segments.len()).sum::<usize>(),

@@ -147,12 +147,6 @@ impl Lighting {
         eval(&self.coef, &terms(u, v))
     }
 
-    /// The range of the paper's brightness over the picture (0..=1):
-    /// darkest and brightest.
-    pub fn range(&self) -> (f64, f64) {
-        (self.darkest, self.brightest)
-    }
-
     /// One line for `--verbose`: what was evened out.
     pub fn note(&self) -> String {
         format!(

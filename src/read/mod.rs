@@ -8,24 +8,38 @@ pub mod sketch;
 pub mod style;
 pub mod svg;
 
-/// How inputs are read.
+/// How a picture is read as ink.
 #[derive(Clone, Debug)]
-pub struct InputOptions {
-    /// Longest side in pixels at which SVG input is rasterized (default
-    /// 1024). Raster input is used at its own size.
+pub struct ImageOptions {
+    /// Longest side, px, at which SVG input is rasterized (at least 1;
+    /// default 1024). Raster input is read at its own size.
     pub resolution: u32,
-    /// Trace the paper instead of the ink.
+    /// Read the paper as ink and the ink as paper (default `false`).
     pub invert: bool,
-    /// One layer per fill colour instead of one layer of all ink.
+    /// One layer per fill colour (SVG) or quantized colour (raster)
+    /// instead of one layer of all ink (default `false`).
     pub layers: bool,
 }
 
-impl Default for InputOptions {
+impl Default for ImageOptions {
     fn default() -> Self {
-        InputOptions {
+        ImageOptions {
             resolution: 1024,
             invert: false,
             layers: false,
         }
+    }
+}
+
+impl ImageOptions {
+    /// Checks every value's range.
+    pub fn validate(&self) -> crate::error::Result<()> {
+        if self.resolution == 0 {
+            return Err(crate::error::Error::Option {
+                name: "resolution",
+                reason: "must be at least 1 px".into(),
+            });
+        }
+        Ok(())
     }
 }

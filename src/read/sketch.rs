@@ -16,13 +16,11 @@
 //! overlays it exactly.
 
 use crate::error::{Error, Result};
-use crate::io;
 use crate::read::svg::{affine_of, to_bezpath};
 use crate::svg_out::FillRule;
 use kurbo::{Affine, BezPath, Rect, Shape as _};
 use resvg::usvg;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
 
 /// Prefix of the ids given to shapes that carry `data-style` but no `id`.
 const PRIVATE_ID: &str = "flourish-ds-";
@@ -71,8 +69,6 @@ impl Query {
 /// A parsed sketch.
 #[derive(Clone, Debug)]
 pub struct Sketch {
-    /// The file it came from (for error messages).
-    pub path: PathBuf,
     /// The `width` of the sketch, in user units of its viewport (px).
     pub width: f64,
     /// The `height` of the sketch, in px.
@@ -88,21 +84,27 @@ pub struct Sketch {
     pub warnings: Vec<String>,
 }
 
-/// Reads and parses a sketch SVG file.
-pub fn load(path: &Path) -> Result<Sketch> {
-    let data = io::read_file(path)?;
-    parse(path, &data)
+impl Sketch {
+    /// Parses sketch SVG bytes (plain or SVGZ): every visible shape
+    /// becomes a query, in document order (SPEC.md, "Sketch SVG").
+    pub fn from_svg(bytes: &[u8]) -> Result<Sketch> {
+        parse(bytes)
+    }
 }
 
-/// Parses sketch SVG bytes; `path` names the file in errors.
-pub fn parse(path: &Path, data: &[u8]) -> Result<Sketch> {
-    let data = &*crate::read::svg::inflate_svgz(path, data)?;
-    let text = std::str::from_utf8(data).map_err(|_| Error::Svg {
-        path: path.to_path_buf(),
-        reason: "not UTF-8 text".into(),
-    })?;
-    let pre = preprocess(path, text)?;
-    let tree = crate::read::svg::parse_svg(path, pre.text.as_bytes())?;
+/// Reads and parses a sketch SVG file; errors name it.
+#[cfg(test)]
+pub fn load(path: &std::path::Path) -> Result<Sketch> {
+    let data = crate::io::read_file(path)?;
+    parse(&data).map_err(|e| e.in_file(path))
+}
+
+/// Parses sketch SVG bytes (plain or SVGZ).
+pub fn parse(data: &[u8]) -> Result<Sketch> {
+    let data = &*crate::read::svg::inflate_svgz(data)?;
+    let text = std::str::from_utf8(data).map_err(|_| Error::Svg("not UTF-8 text".into()))?;
+    let pre = preprocess(text)?;
+    let tree = crate::read::svg::parse_svg(pre.text.as_bytes())?;
     let size = tree.size();
     let (width, height) = (size.width() as f64, size.height() as f64);
     let view_box = pre.view_box.unwrap_or(Rect::new(0.0, 0.0, width, height));
@@ -110,7 +112,6 @@ pub fn parse(path: &Path, data: &[u8]) -> Result<Sketch> {
     // user units (SVG 1.1 §7.8, preserveAspectRatio).
     let to_user = viewport_to_user(view_box, width, height, &pre.aspect);
     let mut sketch = Sketch {
-        path: path.to_path_buf(),
         width,
         height,
         view_box,
@@ -139,16 +140,13 @@ const SHAPES: [&str; 7] = [
 
 /// Reads `viewBox`, `preserveAspectRatio` and `data-style` from the raw XML
 /// and gives styled shapes without an id a private one.
-fn preprocess(path: &Path, text: &str) -> Result<Preprocessed> {
+fn preprocess(text: &str) -> Result<Preprocessed> {
     let opts = usvg::roxmltree::ParsingOptions {
         allow_dtd: true,
         ..Default::default()
     };
-    let doc =
-        usvg::roxmltree::Document::parse_with_options(text, opts).map_err(|e| Error::Svg {
-            path: path.to_path_buf(),
-            reason: e.to_string(),
-        })?;
+    let doc = usvg::roxmltree::Document::parse_with_options(text, opts)
+        .map_err(|e| Error::Svg(e.to_string()))?;
     let root = doc.root_element();
     let view_box = root.attribute("viewBox").and_then(parse_view_box);
     let aspect = root
@@ -327,7 +325,7 @@ mod tests {
             <g data-style="stipple"><rect x="10" y="50" width="100" height="100" fill="#f00"/></g>
             <circle cx="300" cy="100" r="40" fill="none" stroke="none"/>
         </svg>"##;
-        let s = parse(Path::new("t.svg"), svg.as_bytes()).unwrap();
+        let s = parse(svg.as_bytes()).unwrap();
         assert_eq!(s.view_box, Rect::new(0.0, 0.0, 400.0, 200.0));
         assert_eq!(s.queries.len(), 2);
         assert_eq!(s.queries[0].id, "spine");

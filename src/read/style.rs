@@ -143,7 +143,7 @@ fn check_direction(
         }
         _ => return Ok(()),
     };
-    Err(Error::invalid(path, format!("{key}: {why}")))
+    Err(Error::invalid(format!("{key}: {why}")).in_file(path))
 }
 
 /// Parses `style.toml` text; `path` names the file in errors.
@@ -155,8 +155,8 @@ pub fn parse(path: &Path, text: &str) -> Result<StyleToml> {
             .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1);
         let msg = e.message().replace('\n', " ");
         match line {
-            Some(l) => Error::invalid(path, format!("line {l}: {}", msg.trim())),
-            None => Error::invalid(path, msg.trim().to_string()),
+            Some(l) => Error::invalid(format!("line {l}: {}", msg.trim())).in_file(path),
+            None => Error::invalid(msg.trim().to_string()).in_file(path),
         }
     })?;
     parsed.validate(path)?;
@@ -167,14 +167,16 @@ pub fn parse(path: &Path, text: &str) -> Result<StyleToml> {
 pub fn load(dir: &Path) -> Result<StyleToml> {
     let path = dir.join(STYLE_FILE);
     let bytes = crate::io::read_file(&path)?;
-    let text = String::from_utf8(bytes).map_err(|_| Error::invalid(&path, "not UTF-8 text"))?;
+    let text =
+        String::from_utf8(bytes).map_err(|_| Error::invalid("not UTF-8 text").in_file(&path))?;
     parse(&path, &text)
 }
 
 impl StyleToml {
     /// Checks value ranges that serde cannot express; errors name the key.
     pub fn validate(&self, path: &Path) -> Result<()> {
-        let bad = |key: &str, why: String| Err(Error::invalid(path, format!("{key}: {why}")));
+        let bad =
+            |key: &str, why: String| Err(Error::invalid(format!("{key}: {why}")).in_file(path));
         if let Some(r) = self.resolution {
             if !(64..=1024).contains(&r) {
                 return bad("resolution", format!("must be within 64..1024 px, got {r}"));
@@ -282,7 +284,8 @@ impl StyleToml {
 
     /// The fill keys: ranges, and exactly one tile.
     fn validate_fill(&self, path: &Path) -> Result<()> {
-        let bad = |key: &str, why: String| Err(Error::invalid(path, format!("{key}: {why}")));
+        let bad =
+            |key: &str, why: String| Err(Error::invalid(format!("{key}: {why}")).in_file(path));
         check_direction(path, "direction", &self.direction, "etf")?;
         check_direction(path, "flow", &self.flow, "outline")?;
         if let Some(p) = self.patch {
@@ -320,121 +323,20 @@ impl StyleToml {
     /// Fails unless the style is of `kind`.
     pub fn expect_kind(&self, path: &Path, kind: StyleKind) -> Result<()> {
         if self.kind != kind {
-            return Err(Error::invalid(
-                path.join(STYLE_FILE),
-                format!(
-                    "kind: is \"{}\", this command needs \"{}\"",
-                    self.kind.name(),
-                    kind.name()
-                ),
-            ));
+            return Err(Error::invalid(format!(
+                "kind: is \"{}\", this command needs \"{}\"",
+                self.kind.name(),
+                kind.name()
+            ))
+            .in_file(path.join(STYLE_FILE)));
         }
         Ok(())
     }
 }
 
-/// Finds a style folder: `style` itself when it is a folder holding
-/// `style.toml`, else `styles_dir/style` (the `--styles DIR` lookup).
-pub fn resolve(style: &str, styles_dir: &Path) -> Result<PathBuf> {
-    let direct = Path::new(style);
-    if direct.join(STYLE_FILE).is_file() {
-        return Ok(direct.to_path_buf());
-    }
-    let named = styles_dir.join(style);
-    if named.join(STYLE_FILE).is_file() {
-        return Ok(named);
-    }
-    Err(Error::invalid(
-        direct,
-        format!(
-            "style not found: neither {} nor {} exists",
-            direct.join(STYLE_FILE).display(),
-            named.join(STYLE_FILE).display()
-        ),
-    ))
-}
-
-/// Finds the folder of a sketch shape's `data-style="NAME"`: NAME must be
-/// a bare name (no folder separators, not `.` or `..`) and is looked up in
-/// `styles_dir` only, so a sketch cannot make flourish read files outside
-/// the styles folder (`data-style="/etc"`, `"../../x"`). Errors name the
-/// sketch file and the query.
-pub fn resolve_data_style(
-    sketch: &Path,
-    query_id: &str,
-    name: &str,
-    styles_dir: &Path,
-) -> Result<PathBuf> {
-    let mut parts = Path::new(name).components();
-    let bare = matches!(
-        (parts.next(), parts.next()),
-        (Some(std::path::Component::Normal(n)), None) if n == std::ffi::OsStr::new(name)
-    );
-    if !bare {
-        return Err(Error::invalid(
-            sketch,
-            format!("{query_id}: data-style \"{name}\" is not a style name (a folder name in {}, without slashes)", styles_dir.display()),
-        ));
-    }
-    let dir = styles_dir.join(name);
-    if dir.join(STYLE_FILE).is_file() {
-        return Ok(dir);
-    }
-    Err(Error::invalid(
-        sketch,
-        format!(
-            "{query_id}: data-style \"{name}\": style not found: {} does not exist",
-            dir.join(STYLE_FILE).display()
-        ),
-    ))
-}
-
-/// The styles shipped with the tool (the crate's `styles/` folder).
-pub fn default_styles_dir() -> PathBuf {
-    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/styles"))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// A shape's `data-style` is a name in the styles folder, never a
-    /// path: absolute, relative, parent and empty names are refused with
-    /// the sketch and query named; a missing name says so.
-    #[test]
-    fn data_style_is_a_name_in_the_styles_folder() {
-        let styles = default_styles_dir();
-        let sketch = Path::new("sketch.svg");
-        assert_eq!(
-            resolve_data_style(sketch, "q-1", "knot", &styles).expect("shipped"),
-            styles.join("knot")
-        );
-        for bad in [
-            "/etc",
-            "../styles/knot",
-            "knot/",
-            "./knot",
-            "..",
-            ".",
-            "",
-            "a/b",
-        ] {
-            let e = resolve_data_style(sketch, "q-1", bad, &styles)
-                .expect_err(bad)
-                .to_string();
-            assert!(
-                e.starts_with("sketch.svg: q-1: data-style") && !e.contains('\n'),
-                "{bad:?}: {e}"
-            );
-        }
-        let e = resolve_data_style(sketch, "q-2", "no-such-style", &styles)
-            .expect_err("missing")
-            .to_string();
-        assert!(
-            e.starts_with("sketch.svg: q-2: data-style \"no-such-style\": style not found"),
-            "{e}"
-        );
-    }
 
     #[test]
     fn pattern_style_parses() {

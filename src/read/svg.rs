@@ -8,12 +8,11 @@
 //! same colours.
 
 use crate::error::{Error, Result};
-use crate::io::{read_file, MAX_FILE_BYTES};
+use crate::io::MAX_FILE_BYTES;
 use crate::svg_out::Color;
 use kurbo::{Affine, BezPath};
 use resvg::usvg;
 use std::borrow::Cow;
-use std::path::Path;
 
 /// usvg options that never touch the file system or the network: external
 /// and embedded images are ignored, no fonts are loaded.
@@ -30,12 +29,12 @@ pub fn svg_options() -> usvg::Options<'static> {
 
 /// SVG bytes as plain text bytes: SVGZ (gzip) inflated, refusing more
 /// than [`MAX_FILE_BYTES`] once inflated (a small file can inflate a
-/// thousandfold); plain SVG as it is. `path` names the file in errors.
-pub fn inflate_svgz<'a>(path: &Path, data: &'a [u8]) -> Result<Cow<'a, [u8]>> {
-    inflate_capped(path, data, MAX_FILE_BYTES)
+/// thousandfold); plain SVG as it is.
+pub fn inflate_svgz(data: &[u8]) -> Result<Cow<'_, [u8]>> {
+    inflate_capped(data, MAX_FILE_BYTES)
 }
 
-fn inflate_capped<'a>(path: &Path, data: &'a [u8], cap: u64) -> Result<Cow<'a, [u8]>> {
+fn inflate_capped(data: &[u8], cap: u64) -> Result<Cow<'_, [u8]>> {
     use std::io::Read as _;
     if !data.starts_with(&[0x1f, 0x8b]) {
         return Ok(Cow::Borrowed(data));
@@ -44,30 +43,24 @@ fn inflate_capped<'a>(path: &Path, data: &'a [u8], cap: u64) -> Result<Cow<'a, [
     flate2::read::GzDecoder::new(data)
         .take(cap + 1)
         .read_to_end(&mut out)
-        .map_err(|e| Error::Svg {
-            path: path.to_path_buf(),
-            reason: format!("SVGZ does not inflate: {e}"),
-        })?;
+        .map_err(|e| Error::Svg(format!("SVGZ does not inflate: {e}")))?;
     if out.len() as u64 > cap {
-        return Err(Error::invalid(
-            path,
-            format!("SVGZ inflates to more than the limit of {cap} bytes"),
-        ));
+        return Err(Error::invalid(format!(
+            "SVGZ inflates to more than the limit of {cap} bytes"
+        )));
     }
     Ok(Cow::Owned(out))
 }
 
 /// Parses SVG bytes (plain or SVGZ, see [`inflate_svgz`]) with
-/// [`svg_options`]; `path` names the file in errors.
-pub fn parse_svg(path: &Path, data: &[u8]) -> Result<usvg::Tree> {
-    let data = inflate_svgz(path, data)?;
-    let tree = usvg::Tree::from_data(&data, &svg_options()).map_err(|e| Error::Svg {
-        path: path.to_path_buf(),
-        reason: e.to_string(),
-    })?;
+/// [`svg_options`].
+pub fn parse_svg(data: &[u8]) -> Result<usvg::Tree> {
+    let data = inflate_svgz(data)?;
+    let tree =
+        usvg::Tree::from_data(&data, &svg_options()).map_err(|e| Error::Svg(e.to_string()))?;
     let size = tree.size();
     if !(size.width().is_finite() && size.height().is_finite()) {
-        return Err(Error::invalid(path, "SVG size is not finite"));
+        return Err(Error::invalid("SVG size is not finite"));
     }
     Ok(tree)
 }
@@ -95,9 +88,10 @@ pub fn text_left_out(data: &[u8]) -> Option<&'static str> {
 }
 
 /// Reads and parses an SVG file.
-pub fn load_svg(path: &Path) -> Result<usvg::Tree> {
-    let data = read_file(path)?;
-    parse_svg(path, &data)
+#[cfg(test)]
+pub fn load_svg(path: &std::path::Path) -> Result<usvg::Tree> {
+    let data = crate::io::read_file(path)?;
+    parse_svg(&data).map_err(|e| e.in_file(path))
 }
 
 /// Converts a tiny-skia path under transform `ts` into a kurbo path.
@@ -169,28 +163,21 @@ mod tests {
 
     /// SVGZ inflates to the SVG it holds, plain SVG passes as it is, and
     /// what inflates past the cap (a small file of zeros) or is not gzip
-    /// after its magic is refused with the file named.
+    /// after its magic is refused.
     #[test]
     fn svgz_inflates_within_its_cap() {
-        let path = Path::new("art.svgz");
         let svg = br#"<svg xmlns="http://www.w3.org/2000/svg" width="10" height="10"/>"#;
-        assert_eq!(
-            &*inflate_capped(path, &gzip(svg), 1000).expect("inflates"),
-            svg
-        );
+        assert_eq!(&*inflate_capped(&gzip(svg), 1000).expect("inflates"), svg);
         assert!(matches!(
-            inflate_capped(path, svg, 1).expect("plain"),
+            inflate_capped(svg, 1).expect("plain"),
             Cow::Borrowed(_)
         ));
         let bomb = gzip(&vec![0u8; 100_000]);
         assert!(bomb.len() < 1000);
-        let e = inflate_capped(path, &bomb, 10_000).expect_err("over the cap");
-        assert!(
-            e.to_string().contains("art.svgz") && e.to_string().contains("limit"),
-            "{e}"
-        );
-        let e = inflate_capped(path, &[0x1f, 0x8b, 1, 2, 3], 1000).expect_err("not gzip");
-        assert!(e.to_string().contains("art.svgz"), "{e}");
-        assert!(parse_svg(path, &gzip(svg)).is_ok());
+        let e = inflate_capped(&bomb, 10_000).expect_err("over the cap");
+        assert!(e.to_string().contains("limit"), "{e}");
+        let e = inflate_capped(&[0x1f, 0x8b, 1, 2, 3], 1000).expect_err("not gzip");
+        assert!(e.to_string().contains("SVGZ"), "{e}");
+        assert!(parse_svg(&gzip(svg)).is_ok());
     }
 }

@@ -23,11 +23,10 @@ use crate::outline::paths::{self, Bitmap};
 use crate::outline::smooth::{self, SmoothLoop};
 use crate::raster::contour::{self, contains, Contour};
 use crate::raster::Sdf;
-use crate::read::ink::{self, Ink, InputOptions, LayerOutline, Traceable};
-use crate::svg_out::{decimals_for, Color, Document, FillRule, Group, Shape};
+use crate::read::ink::{Ink, LayerOutline, Traceable};
+use crate::svg_out::{decimals_for, Color, Document, FillRule, Group, Output, Shape};
 use kurbo::{BezPath, Point, Rect};
 use rayon::prelude::*;
-use std::path::Path;
 
 /// Tracing parameters, in pixels of the SDF.
 #[derive(Clone, Debug)]
@@ -53,13 +52,13 @@ impl TraceOptions {
     pub fn validate(&self) -> Result<()> {
         if !(self.tolerance.is_finite() && self.tolerance >= 0.01 && self.tolerance <= 100.0) {
             return Err(Error::Option {
-                name: "--tolerance",
+                name: "tolerance",
                 reason: format!("{} px is not in 0.01..=100", self.tolerance),
             });
         }
         if !(self.min_area.is_finite() && self.min_area >= 0.0) {
             return Err(Error::Option {
-                name: "--min-area",
+                name: "min_area",
                 reason: format!("{} px² is not a non-negative number", self.min_area),
             });
         }
@@ -300,7 +299,7 @@ fn assemble(islands: &[(usize, Vec<usize>)], fitted: &mut [BezPath]) -> Vec<BezP
 
 /// Traces every layer of `ink` into a document the size of the input, one
 /// `<g id="layer-N">` per layer, bottom first.
-pub fn trace_ink(ink: &Ink, opts: &TraceOptions) -> Result<Document> {
+pub fn trace_ink(ink: &Ink, opts: &TraceOptions) -> Result<Output> {
     opts.validate()?;
     let px_per_unit = ink
         .layers
@@ -316,9 +315,11 @@ pub fn trace_ink(ink: &Ink, opts: &TraceOptions) -> Result<Document> {
         doc.groups
             .extend(layer_group(i, trace_sdf(&layer.sdf, opts), layer.color));
     }
-    doc.warnings = ink.warnings.clone();
-    doc.notes = ink.notes.clone();
-    Ok(doc)
+    Ok(Output {
+        document: doc,
+        warnings: ink.warnings.clone(),
+        notes: ink.notes.clone(),
+    })
 }
 
 /// The `<g id="layer-N">` of layer `i`'s traced paths (non-zero fill, so
@@ -336,13 +337,25 @@ fn layer_group(i: usize, paths: Vec<BezPath>, color: Color) -> Option<Group> {
     })
 }
 
-/// Reads `path` (raster or SVG) and traces it: the library side of
-/// `flourish trace`. A raster's layers are traced from their outlines
-/// ([`trace_outline`]); an SVG's from their SDFs.
-pub fn trace_file(path: &Path, input: &InputOptions, opts: &TraceOptions) -> Result<Document> {
+/// Reads `path` (raster or SVG) and traces it ([`trace`]); errors name
+/// the file.
+#[cfg(test)]
+pub fn trace_file(
+    path: &std::path::Path,
+    input: &crate::read::ImageOptions,
+    opts: &TraceOptions,
+) -> Result<Output> {
     opts.validate()?;
-    match ink::load_traceable(path, input)? {
-        Traceable::Field(ink) => trace_ink(&ink, opts),
+    trace(&crate::read::ink::load_traceable(path, input)?, opts).map_err(|e| e.in_file(path))
+}
+
+/// Traces a picture read for tracing: the library side of `flourish
+/// trace`. A raster's layers are traced from their outlines
+/// ([`trace_outline`]); an SVG's from their SDFs.
+pub fn trace(picture: &Traceable, opts: &TraceOptions) -> Result<Output> {
+    opts.validate()?;
+    match picture {
+        Traceable::Field(ink) => trace_ink(ink, opts),
         Traceable::Outline(o) => {
             let mut doc = Document::new(o.width, o.height, decimals_for(opts.tolerance));
             for (i, layer) in o.layers.iter().enumerate() {
@@ -352,8 +365,14 @@ pub fn trace_file(path: &Path, input: &InputOptions, opts: &TraceOptions) -> Res
                 };
                 doc.groups.extend(layer_group(i, paths, layer.color));
             }
-            doc.notes = o.notes;
-            Ok(doc)
+            Ok(Output {
+                document: doc,
+                warnings: Vec::new(),
+                notes: o.notes.clone(),
+            })
         }
     }
 }
+
+#[cfg(test)]
+mod tests;

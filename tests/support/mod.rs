@@ -24,10 +24,7 @@
 
 #![allow(dead_code)]
 
-use flourish::raster::vector::flatten_segments;
-use flourish::read::svg::to_bezpath as to_kurbo;
-use flourish::svg_out::{count_segments, Document};
-use flourish::trace::TraceOptions;
+use flourish::{Document, Image, ImageOptions, TraceOptions};
 use kurbo::{BezPath, Line, PathEl, Point, Rect, Vec2};
 use resvg::tiny_skia;
 use resvg::usvg;
@@ -164,7 +161,7 @@ fn collect(group: &usvg::Group, out: &mut Vec<FlatShape>) {
 
 /// The size of an SVG in user units (= px of its sample PNG).
 pub fn svg_size(svg_path: &Path) -> (f64, f64) {
-    let tree = flourish::read::svg::load_svg(svg_path).expect("ground-truth SVG");
+    let tree = load_svg(svg_path);
     (tree.size().width() as f64, tree.size().height() as f64)
 }
 
@@ -172,7 +169,7 @@ pub fn svg_size(svg_path: &Path) -> (f64, f64) {
 /// coordinates of its rendered PNG; see the module docs.
 pub fn ground_truth(svg_path: &Path) -> Vec<Line> {
     use rayon::prelude::*;
-    let tree = flourish::read::svg::load_svg(svg_path).expect("ground-truth SVG");
+    let tree = load_svg(svg_path);
     let mut shapes = Vec::new();
     collect(tree.root(), &mut shapes);
     let inside = |p: Point| shapes.iter().any(|s| s.contains(p));
@@ -232,9 +229,86 @@ fn keep_pieces(
 // Distances.
 // ---------------------------------------------------------------------------
 
-/// Distance from `p` to segment `l` (the library's own, exact).
+/// Distance from `p` to segment `l`.
 pub fn point_segment_distance(p: Point, l: &Line) -> f64 {
-    flourish::raster::sdf::point_segment_distance(p, *l)
+    let d = l.p1 - l.p0;
+    let len2 = d.hypot2();
+    let t = if len2 > 0.0 {
+        ((p - l.p0).dot(d) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p - (l.p0 + d * t)).hypot()
+}
+
+/// The line segments of `path` flattened within `tolerance`, every subpath
+/// closed.
+pub fn flatten_segments(path: &BezPath, tolerance: f64, out: &mut Vec<Line>) {
+    let mut subpath: Vec<Point> = Vec::new();
+    let close = |pts: &mut Vec<Point>, out: &mut Vec<Line>| {
+        if let (Some(&a), Some(&b)) = (pts.first(), pts.last()) {
+            out.extend(pts.windows(2).map(|w| Line::new(w[0], w[1])));
+            if a != b {
+                out.push(Line::new(b, a));
+            }
+        }
+        pts.clear();
+    };
+    kurbo::flatten(path, tolerance, |el| match el {
+        PathEl::MoveTo(p) => {
+            close(&mut subpath, out);
+            subpath.push(p);
+        }
+        PathEl::LineTo(p) => subpath.push(p),
+        PathEl::ClosePath => close(&mut subpath, out),
+        _ => {}
+    });
+    close(&mut subpath, out);
+}
+
+/// A usvg path under `transform` as a kurbo path.
+pub fn to_kurbo(path: &tiny_skia::Path, transform: tiny_skia::Transform) -> BezPath {
+    let t = transform;
+    let affine = kurbo::Affine::new([
+        t.sx as f64,
+        t.ky as f64,
+        t.kx as f64,
+        t.sy as f64,
+        t.tx as f64,
+        t.ty as f64,
+    ]);
+    let pt = |p: tiny_skia::Point| affine * Point::new(p.x as f64, p.y as f64);
+    let mut out = BezPath::new();
+    for seg in path.segments() {
+        match seg {
+            tiny_skia::PathSegment::MoveTo(p) => out.move_to(pt(p)),
+            tiny_skia::PathSegment::LineTo(p) => out.line_to(pt(p)),
+            tiny_skia::PathSegment::QuadTo(a, b) => out.quad_to(pt(a), pt(b)),
+            tiny_skia::PathSegment::CubicTo(a, b, c) => out.curve_to(pt(a), pt(b), pt(c)),
+            tiny_skia::PathSegment::Close => out.close_path(),
+        }
+    }
+    out
+}
+
+/// Lines and curves drawn in `path` (moves and closes are not segments),
+/// as the SVG writer counts them.
+fn count_segments(path: &BezPath) -> usize {
+    path.elements()
+        .iter()
+        .filter(|e| {
+            matches!(
+                e,
+                PathEl::LineTo(_) | PathEl::QuadTo(..) | PathEl::CurveTo(..)
+            )
+        })
+        .count()
+}
+
+/// Parses an SVG file with usvg.
+fn load_svg(path: &Path) -> usvg::Tree {
+    let data = std::fs::read(path).expect("SVG file");
+    usvg::Tree::from_data(&data, &usvg::Options::default()).expect("SVG parses")
 }
 
 /// A uniform grid of segments for nearest-distance queries.
@@ -546,7 +620,7 @@ pub fn run_potrace(bitmap: &image::GrayImage, runs: usize) -> (Vec<BezPath>, usi
         times.push(t.elapsed());
         assert!(st.success(), "potrace failed: {st}");
     }
-    let tree = flourish::read::svg::load_svg(&svg).expect("potrace SVG");
+    let tree = load_svg(&svg);
     // potrace writes width/height in pt; map the tree's size onto the bitmap.
     let scale = (
         bitmap.width() as f64 / tree.size().width() as f64,
@@ -624,7 +698,7 @@ pub fn flourish_options() -> TraceOptions {
     o
 }
 
-/// Traces `png` with `flourish::trace::trace_file` and [`flourish_options`]:
+/// Traces `png` with `flourish::trace` and [`flourish_options`]:
 /// the document and the median in-process time of `runs` runs.
 pub fn run_flourish(png: &Path, runs: usize) -> (Document, Duration) {
     let mut times = Vec::new();
@@ -632,8 +706,11 @@ pub fn run_flourish(png: &Path, runs: usize) -> (Document, Duration) {
     let opts = flourish_options();
     for _ in 0..runs.max(1) {
         let t = Instant::now();
-        let d =
-            flourish::trace::trace_file(png, &Default::default(), &opts).expect("flourish trace");
+        let bytes = std::fs::read(png).expect("sample");
+        let image = Image::from_bytes(&bytes, &ImageOptions::default()).expect("reads");
+        let d = flourish::trace(&image, &opts)
+            .expect("flourish trace")
+            .document;
         times.push(t.elapsed());
         doc = Some(d);
     }

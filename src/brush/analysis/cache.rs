@@ -147,8 +147,9 @@ pub fn write(path: &Path, key: &[u8; 32], style: &BrushStyle) -> Result<()> {
     bytes.extend_from_slice(MAGIC);
     bytes.extend_from_slice(&ANALYSIS_VERSION.to_le_bytes());
     bytes.extend_from_slice(key);
-    let body = encode(style)
-        .map_err(|e| crate::Error::invalid(path, format!("cannot encode the analysis: {e}")))?;
+    let body = encode(style).map_err(|e| {
+        crate::Error::invalid(format!("cannot encode the analysis: {e}")).in_file(path)
+    })?;
     bytes.extend_from_slice(&body);
     io::write_atomic(path, &bytes)?;
     remove_stale(path);

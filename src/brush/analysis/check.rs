@@ -9,7 +9,6 @@ use crate::raster::Grid;
 use crate::svg_out::Color;
 use resvg::tiny_skia;
 use std::fmt::Write as _;
-use std::path::Path;
 
 /// Warning thresholds.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -73,16 +72,29 @@ pub struct ExemplarReport {
 #[derive(Clone, Debug, PartialEq)]
 pub struct StyleReport {
     /// The style's name.
-    pub name: String,
+    pub(crate) name: String,
     /// Level sizes (longest side, px), coarse to fine.
-    pub levels: Vec<u32>,
+    pub(crate) levels: Vec<u32>,
     /// Indexed neighbourhoods per level, coarse to fine.
-    pub neighbourhoods: Vec<usize>,
+    pub(crate) neighbourhoods: Vec<usize>,
     /// One report per exemplar.
-    pub exemplars: Vec<ExemplarReport>,
+    pub(crate) exemplars: Vec<ExemplarReport>,
 }
 
 impl StyleReport {
+    /// The style's name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Every warning: the exemplar file (relative to the style folder)
+    /// and what is wrong with it.
+    pub fn warnings(&self) -> impl Iterator<Item = (&str, &str)> {
+        self.exemplars
+            .iter()
+            .flat_map(|e| e.warnings.iter().map(|w| (e.file.as_str(), w.as_str())))
+    }
+
     /// Number of warnings over all exemplars.
     pub fn warning_count(&self) -> usize {
         self.exemplars.iter().map(|e| e.warnings.len()).sum()
@@ -274,13 +286,12 @@ pub const COLUMNS: u32 = 3;
 /// `style.toml` order) showing the ink in its layer colours over the stroke
 /// region (pale blue), ribs (grey), the orientation field (short dark blue
 /// ticks pointing along `ω`) and the spine from red (start) to green (end).
-/// `out` names the sheet in errors.
-pub fn sheet_png(style: &BrushStyle, out: &Path) -> Result<Vec<u8>> {
+pub fn sheet_png(style: &BrushStyle) -> Result<Vec<u8>> {
     let n = style.exemplars.len().max(1) as u32;
     let cols = n.min(COLUMNS);
     let rows = n.div_ceil(COLUMNS);
     let mut pm = tiny_skia::Pixmap::new(cols * PANEL_W, rows * PANEL_H)
-        .ok_or_else(|| Error::invalid(out, "cannot allocate the sheet"))?;
+        .ok_or_else(|| Error::invalid("cannot allocate the sheet"))?;
     pm.fill(tiny_skia::Color::WHITE);
     for (i, e) in style.exemplars.iter().enumerate() {
         let (cx, cy) = (
@@ -304,7 +315,7 @@ pub fn sheet_png(style: &BrushStyle, out: &Path) -> Result<Vec<u8>> {
         pm.height(),
         image::ExtendedColorType::Rgba8,
     )
-    .map_err(|e| Error::invalid(out, format!("PNG encoding failed: {e}")))?;
+    .map_err(|e| Error::invalid(format!("PNG encoding failed: {e}")))?;
     Ok(png)
 }
 

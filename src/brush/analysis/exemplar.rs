@@ -20,7 +20,7 @@ use crate::error::{Error, Result};
 use crate::io;
 use crate::raster::plain::quantize_sdf;
 use crate::raster::{Coverage, Grid, Sdf};
-use crate::read::ink::{self, InputOptions};
+use crate::read::ink::{self, ImageOptions};
 use crate::svg_out::Color;
 use kurbo::{Affine, BezPath, PathEl, Point};
 use resvg::usvg;
@@ -106,25 +106,26 @@ pub fn load(path: &Path, resolution: u32) -> Result<ExemplarInk> {
     let finest = ex
         .levels
         .last()
-        .ok_or_else(|| Error::invalid(path, "no pyramid levels"))?;
+        .ok_or_else(|| Error::invalid("no pyramid levels").in_file(path))?;
     if finest.layers.is_empty() || finest.ink.data().iter().all(|&d| d >= 0.0) {
-        return Err(Error::invalid(path, "blank exemplar: it has no ink"));
+        return Err(Error::invalid("blank exemplar: it has no ink").in_file(path));
     }
     Ok(ex)
 }
 
 fn load_svg(path: &Path, bytes: &[u8], resolution: u32) -> Result<ExemplarInk> {
-    let tree = crate::read::svg::parse_svg(path, bytes)?;
+    let tree = crate::read::svg::parse_svg(bytes).map_err(|e| e.in_file(path))?;
     let size = [tree.size().width() as f64, tree.size().height() as f64];
     let mut levels = Vec::with_capacity(LEVELS);
     for l in 0..LEVELS {
         let res = level_resolution(resolution, l);
-        let opts = InputOptions {
+        let opts = ImageOptions {
             resolution: res,
             invert: false,
             layers: true,
         };
-        let mut layered = ink::svg_ink(path, &tree, &opts, Some(SPINE_ID))?;
+        let mut layered =
+            ink::svg_ink(&tree, &opts, Some(SPINE_ID)).map_err(|e| e.in_file(path))?;
         for l in &mut layered.layers {
             quantize_sdf(&mut l.sdf.dist);
         }
@@ -192,15 +193,15 @@ fn polyline(path: &BezPath) -> Vec<Point> {
 }
 
 fn load_raster(path: &Path, bytes: &[u8], resolution: u32) -> Result<ExemplarInk> {
-    let native = ink::load_raster(
-        path,
+    let native = ink::read_raster(
         bytes,
-        &InputOptions {
+        &ImageOptions {
             resolution,
             invert: false,
             layers: true,
         },
-    )?;
+    )
+    .map_err(|e| e.in_file(path))?;
     let size = [native.width, native.height];
     let covs: Vec<(Color, Coverage)> = native
         .layers

@@ -87,14 +87,14 @@ impl BrushStyle {
         let toml_path = dir.join(STYLE_FILE);
         let toml_bytes = crate::io::read_file(&toml_path)?;
         let text = String::from_utf8(toml_bytes.clone())
-            .map_err(|_| Error::invalid(&toml_path, "not UTF-8 text"))?;
+            .map_err(|_| Error::invalid("not UTF-8 text").in_file(&toml_path))?;
         let toml = crate::read::style::parse(&toml_path, &text)?;
         toml.expect_kind(dir, StyleKind::Brush)?;
         if toml.exemplar.is_empty() {
             return Err(Error::invalid(
-                &toml_path,
                 "exemplar: a brush style needs at least one [[exemplar]] table",
-            ));
+            )
+            .in_file(&toml_path));
         }
         let files: Vec<PathBuf> = toml.exemplar.iter().map(|e| dir.join(&e.file)).collect();
         let key = cache::style_key(&toml_bytes, &files)?;
@@ -158,10 +158,9 @@ pub fn analyse(
             .collect();
         let refs = region_refs(&exemplars, l);
         if refs.len() != all.len() {
-            return Err(Error::invalid(
-                dir,
-                "internal: neighbourhoods and stroke region disagree",
-            ));
+            return Err(
+                Error::invalid("internal: neighbourhoods and stroke region disagree").in_file(dir),
+            );
         }
         let pca = Pca::fit(&all);
         let points: Vec<[f32; PCA_DIMS]> = all.par_iter().map(|v| pca.project(v)).collect();
@@ -192,20 +191,18 @@ fn analyse_exemplar(
     for (key, p) in [("start", ex.start), ("end", ex.end)] {
         if let Some([x, y]) = p {
             if !(0.0..=uw).contains(&x) || !(0.0..=uh).contains(&y) {
-                return Err(Error::invalid(
-                    toml_path,
-                    format!(
-                        "exemplar[{i}].{key}: [{x}, {y}] lies outside {} ({uw}×{uh} user units)",
-                        ex.file.display()
-                    ),
-                ));
+                return Err(Error::invalid(format!(
+                    "exemplar[{i}].{key}: [{x}, {y}] lies outside {} ({uw}×{uh} user units)",
+                    ex.file.display()
+                ))
+                .in_file(toml_path));
             }
         }
     }
     let fine = ink
         .levels
         .last()
-        .ok_or_else(|| Error::invalid(&path, "no pyramid levels"))?;
+        .ok_or_else(|| Error::invalid("no pyramid levels").in_file(&path))?;
     let fine_ppu = fine.px_per_unit;
     let to_fine = |p: Point| Point::new(p.x * fine_ppu, p.y * fine_ppu);
     let (spine_source, spine, path_px) = match (&ink.drawn_spine, ex.start, ex.end) {
@@ -233,7 +230,7 @@ fn analyse_exemplar(
             let s = Point::new(sx * lv.px_per_unit, sy * lv.px_per_unit);
             let e = Point::new(ex_ * lv.px_per_unit, ey * lv.px_per_unit);
             let (raw, fit) = spine::trace_spine(&lv.ink, s, e, &opts.spine)
-                .map_err(|e| Error::invalid(&path, format!("spine: {e}")))?;
+                .map_err(|e| Error::invalid(format!("spine: {e}")).in_file(&path))?;
             let k = fine_ppu / lv.px_per_unit;
             let up = |p: Point| Point::new(p.x * k, p.y * k);
             (
@@ -243,18 +240,16 @@ fn analyse_exemplar(
             )
         }
         _ => {
-            return Err(Error::invalid(
-                toml_path,
-                format!(
-                    "exemplar[{i}]: {} has no path id=\"spine\"; give start and end",
-                    ex.file.display()
-                ),
+            return Err(Error::invalid(format!(
+                "exemplar[{i}]: {} has no path id=\"spine\"; give start and end",
+                ex.file.display()
             ))
+            .in_file(toml_path))
         }
     };
     let length: f64 = spine.windows(2).map(|w| w[0].distance(w[1])).sum();
     if length <= 0.0 {
-        return Err(Error::invalid(&path, "the spine has no length"));
+        return Err(Error::invalid("the spine has no length").in_file(&path));
     }
     let coarse = ink.levels[0].px_per_unit / fine_ppu;
     let reach = 0.5 * fine.ink.width().max(fine.ink.height()) as f64;
@@ -308,3 +303,6 @@ fn analyse_exemplar(
         hoods,
     ))
 }
+
+#[cfg(test)]
+mod tests;

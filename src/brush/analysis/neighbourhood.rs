@@ -235,6 +235,7 @@ impl NeighbourhoodIndex {
     }
 
     /// Whether nothing is indexed.
+    #[cfg(test)]
     pub fn is_empty(&self) -> bool {
         self.points.is_empty()
     }
@@ -249,11 +250,6 @@ impl NeighbourhoodIndex {
                 }
             })
             .as_ref()
-    }
-
-    /// Builds the k-d tree now (it is otherwise built by the first search).
-    pub fn prepare(&self) {
-        let _ = self.tree();
     }
 
     /// The indexed neighbourhood nearest to `query` in PCA space, with its

@@ -94,7 +94,7 @@ pub fn shortest_path(
 ) -> Result<Vec<Point>> {
     let (w, h) = (flow.width(), flow.height());
     if w == 0 || h == 0 {
-        return Err(Error::invalid("spine", "empty exemplar grid"));
+        return Err(Error::invalid("empty exemplar grid").in_file("spine"));
     }
     let pixel = |p: Point| -> usize {
         let x = (p.x.floor().max(0.0) as usize).min(w - 1);
@@ -170,14 +170,14 @@ pub fn shortest_path(
         }
     }
     if !dist[e].is_finite() {
-        return Err(Error::invalid("spine", "no path between start and end"));
+        return Err(Error::invalid("no path between start and end").in_file("spine"));
     }
     let mut idx = vec![e];
     let mut i = e;
     while i != s {
         i = parent[i];
         if i == usize::MAX || idx.len() > w * h {
-            return Err(Error::invalid("spine", "broken path"));
+            return Err(Error::invalid("broken path").in_file("spine"));
         }
         idx.push(i);
     }

@@ -3,8 +3,10 @@
 //! What [`super::cache`] stores and [`super::BrushStyle::load`] returns.
 
 use super::exemplar::{InkLevel, LEVELS};
+#[cfg(test)]
+use super::neighbourhood::Neighbourhood;
 use super::neighbourhood::{
-    Neighbourhood, NeighbourhoodIndex, NeighbourhoodRef, NeighbourhoodSampler, PCA_DIMS, SIZE,
+    NeighbourhoodIndex, NeighbourhoodRef, NeighbourhoodSampler, PCA_DIMS, SIZE,
 };
 use super::uv::{OrientationField, Ribs, SampleFeatures};
 use serde::{Deserialize, Serialize};
@@ -165,6 +167,7 @@ impl BrushStyle {
 
     /// The neighbourhood of exemplar `r.exemplar` at pixel `(r.x, r.y)` of
     /// level `level`, oriented along its per-pixel orientation.
+    #[cfg(test)]
     pub fn neighbourhood(&self, level: usize, r: NeighbourhoodRef) -> Option<Neighbourhood> {
         let lv = self.exemplars.get(r.exemplar as usize)?.levels.get(level)?;
         let (x, y) = (r.x as usize, r.y as usize);

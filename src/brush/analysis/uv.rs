@@ -43,11 +43,6 @@ impl Ribs {
         self.spine.len()
     }
 
-    /// Whether there are no samples.
-    pub fn is_empty(&self) -> bool {
-        self.spine.is_empty()
-    }
-
     /// The same ribs with every point multiplied by `s` (e.g. from the
     /// finest level to a coarser one).
     pub fn scaled(&self, s: f64) -> Ribs {

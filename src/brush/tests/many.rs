@@ -3,13 +3,13 @@
 //! around its ornament, and both give what the per-query, whole-canvas
 //! reading gives.
 
-use flourish::brush::analysis::{AnalysisOptions, BrushStyle};
-use flourish::brush::output::{brush_sketch, extend_field, trace_query};
-use flourish::brush::pipeline::BrushOptions;
-use flourish::brush::synth::{self, Coord, Field};
-use flourish::raster::Grid;
-use flourish::trace::TraceOptions;
-use std::path::{Path, PathBuf};
+use crate::brush::analysis::{AnalysisOptions, BrushStyle};
+use crate::brush::output::{brush_sketch, extend_field, trace_query};
+use crate::brush::pipeline::Settings;
+use crate::brush::synth::{self, Coord, Field};
+use crate::raster::Grid;
+use crate::trace::TraceOptions;
+use std::path::PathBuf;
 use std::sync::OnceLock;
 
 fn root() -> PathBuf {
@@ -146,8 +146,8 @@ fn many_small_strokes_each_trace_as_alone() {
     let svg = format!(
         r#"<svg xmlns="http://www.w3.org/2000/svg" width="160" height="60" viewBox="0 0 160 60">{body}</svg>"#
     );
-    let sk = flourish::read::sketch::parse(Path::new("many.svg"), svg.as_bytes()).expect("parses");
-    let out = brush_sketch(style, &sk, &BrushOptions::default()).expect("brushes");
+    let sk = crate::read::sketch::parse(svg.as_bytes()).expect("parses");
+    let out = brush_sketch(style, &sk, &Settings::default()).expect("brushes");
     assert_eq!(out.queries.len(), 6);
     assert_eq!(out.document.groups.len(), 6);
     for (r, g) in out.queries.iter().zip(&out.document.groups) {

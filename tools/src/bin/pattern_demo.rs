@@ -2,13 +2,27 @@
 //! and writes the outputs and their previews: the golden files and the
 //! README pictures (example | along a path | inside a shape).
 //!
-//! Run: `cargo run --release --example pattern_demo [OUT_DIR]` (default
-//! `golden/pattern`). Prints a line per style with the analysis figures.
+//! Run: `cargo run --release -p flourish-tools --bin pattern_demo [OUT_DIR]`
+//! (default `golden/pattern`). Prints a line per output with its shapes
+//! and time.
 
-use flourish::pattern::{self, PatternOptions, PatternStyle};
-use flourish::render::write_preview;
+use flourish::{Library, PatternOptions, Sketch, StyleKind, StyleOptions, Styles};
+use flourish_tools::{root, write_preview};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+
+type Result<T> = std::result::Result<T, Box<dyn std::error::Error>>;
+
+/// The pattern of shipped `style` (and the shapes' own `data-style`s) in
+/// the sketch `path`.
+fn pattern(style: &str, path: &Path, opts: &PatternOptions) -> Result<flourish::Document> {
+    let lib = Library::shipped();
+    let load = StyleOptions::default();
+    let style = lib.load(style, &load)?;
+    let sketch = Sketch::from_svg(&std::fs::read(path)?)?;
+    let named = lib.load_named(&sketch, StyleKind::Pattern, &load)?;
+    Ok(flourish::pattern(&sketch, Styles::new(&style, &named), opts)?.document)
+}
 
 /// The styles shipped for `pattern`.
 const STYLES: [&str; 4] = ["hatching", "stipple", "flowers", "brushmarks"];
@@ -60,40 +74,29 @@ fn strip(panels: &[String]) -> String {
     s + "</svg>"
 }
 
-fn main() -> flourish::Result<()> {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+fn main() -> Result<()> {
+    let root = root();
     let out: PathBuf = std::env::args()
         .nth(1)
         .map(PathBuf::from)
         .unwrap_or_else(|| root.join("golden/pattern"));
-    std::fs::create_dir_all(&out).map_err(|e| flourish::Error::io(&out, e))?;
+    std::fs::create_dir_all(&out)?;
     let samples = root.join("samples/pattern");
     for style in STYLES {
         let dir = root.join("styles").join(style);
-        let ps = PatternStyle::load(&dir)?;
-        let ex = std::fs::read_to_string(dir.join("example.svg"))
-            .map_err(|e| flourish::Error::io(&dir, e))?;
+        let ex = std::fs::read_to_string(dir.join("example.svg"))?;
         write_preview(&ex, &out.join(format!("{style}-example.png")))?;
-        println!(
-            "{style}: {} strokes -> {} elements, {:?}, spacing {:.2}, A_ref {:.0}",
-            ps.strokes.len(),
-            ps.elements().len(),
-            ps.reference.dist.dim,
-            ps.reference.dist.spacing,
-            ps.reference.dist.area
-        );
         for sample in SAMPLES {
-            let opts = PatternOptions {
-                style: style.into(),
-                styles_dir: root.join("styles"),
-                ..Default::default()
-            };
             let t = Instant::now();
-            let doc = pattern::run(&opts, &samples.join(format!("{sample}.svg")))?;
+            let doc = pattern(
+                style,
+                &samples.join(format!("{sample}.svg")),
+                &PatternOptions::default(),
+            )?;
             let ms = t.elapsed().as_secs_f64() * 1e3;
             let text = doc.to_svg();
             let name = format!("{sample}-{style}");
-            flourish::io::write_atomic(&out.join(format!("{name}.svg")), text.as_bytes())?;
+            std::fs::write(out.join(format!("{name}.svg")), &text)?;
             write_preview(&text, &out.join(format!("{name}.png")))?;
             let n: usize = doc.groups.iter().map(|g| g.shapes.len()).sum();
             println!("  {name}: {n} shapes in {ms:.1} ms");
@@ -101,30 +104,26 @@ fn main() -> flourish::Result<()> {
         // The README strip: example | along a path | inside a shape.
         let panels = [
             ex.clone(),
-            std::fs::read_to_string(out.join(format!("wave-{style}.svg")))
-                .map_err(|e| flourish::Error::io(&out, e))?,
-            std::fs::read_to_string(out.join(format!("blob-{style}.svg")))
-                .map_err(|e| flourish::Error::io(&out, e))?,
+            std::fs::read_to_string(out.join(format!("wave-{style}.svg")))?,
+            std::fs::read_to_string(out.join(format!("blob-{style}.svg")))?,
         ];
         write_preview(&strip(&panels), &out.join(format!("{style}-strip.png")))?;
         // The region again with variation 0.5, to show §3.3.
         let opts = PatternOptions {
-            style: style.into(),
-            styles_dir: root.join("styles"),
             variation: 0.5,
             ..Default::default()
         };
-        let doc = pattern::run(&opts, &samples.join("blob.svg"))?;
+        let doc = pattern(style, &samples.join("blob.svg"), &opts)?;
         let text = doc.to_svg();
         write_preview(&text, &out.join(format!("blob-{style}-variation.png")))?;
     }
-    let opts = PatternOptions {
-        style: "hatching".into(),
-        styles_dir: root.join("styles"),
-        ..Default::default()
-    };
-    let text = pattern::run(&opts, &samples.join("mixed.svg"))?.to_svg();
-    flourish::io::write_atomic(&out.join("mixed.svg"), text.as_bytes())?;
+    let text = pattern(
+        "hatching",
+        &samples.join("mixed.svg"),
+        &PatternOptions::default(),
+    )?
+    .to_svg();
+    std::fs::write(out.join("mixed.svg"), &text)?;
     write_preview(&text, &out.join("mixed.png"))?;
     Ok(())
 }

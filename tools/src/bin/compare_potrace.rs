@@ -13,7 +13,7 @@
 //! documented). flourish is timed in-process (`trace_file`, PNG decoding
 //! included); potrace as a process (wall clock, PBM already written).
 
-#[path = "../tests/support/mod.rs"]
+#[path = "../../../tests/support/mod.rs"]
 mod support;
 
 fn main() {

@@ -6,13 +6,12 @@
 //! that the whole chain is deterministic. Writes the composed ornament to
 //! `$TMPDIR/flourish-brush-stages.png` for a look.
 
-use flourish::brush::arap::{mean_distortion, rasterize_coords, Arap, RibMesh};
-use flourish::brush::graphcut::{overlap_cover, seam, Cover, Label, SeamParams};
-use flourish::brush::matching::{match_query, MatchOptions, SpineFeatures};
-use flourish::brush::query::{self, QueryOptions, QuerySpine};
-use flourish::raster::Grid;
+use crate::brush::arap::{mean_distortion, rasterize_coords, Arap, RibMesh};
+use crate::brush::graphcut::{overlap_cover, seam, Cover, Label, SeamParams};
+use crate::brush::matching::{match_query, MatchOptions, SpineFeatures};
+use crate::brush::query::{self, QueryOptions, QuerySpine};
+use crate::raster::Grid;
 use kurbo::{Affine, Point, Vec2};
-use std::path::Path;
 
 const SPACING: f64 = 2.0;
 const HALF: f64 = 5.0;
@@ -112,7 +111,7 @@ fn sketch_spine() -> QuerySpine {
     let svg = r##"<svg xmlns="http://www.w3.org/2000/svg" width="320" height="160" viewBox="0 0 320 160">
         <path id="vine" d="M20 110 C 80 20, 140 20, 170 80 S 260 150, 300 60" fill="none" stroke="#000" stroke-width="10"/>
     </svg>"##;
-    let sk = flourish::read::sketch::parse(Path::new("vine.svg"), svg.as_bytes()).expect("parses");
+    let sk = crate::read::sketch::parse(svg.as_bytes()).expect("parses");
     let set = query::spines(&sk, &QueryOptions::default()).expect("spines");
     assert!(set.warnings.is_empty(), "{:?}", set.warnings);
     set.spines.into_iter().next().expect("one spine")

@@ -2,35 +2,26 @@
 //! one PNG per shipped style, into `docs/fill-STYLE.png`; and a gallery of
 //! every style in every uncombed sample shape, `docs/fill-gallery.png`.
 //!
-//! Run: `cargo run --release --example fill_readme`.
+//! Run: `cargo run --release -p flourish-tools --bin fill_readme`.
 
-use flourish::fill::{run, FillOptions};
-use flourish::render::render_tree;
+use flourish::{FillOptions, Library, Sketch, StyleOptions};
+use flourish_tools::{inner, render_png, root};
 use std::path::Path;
 
-/// The inside of an SVG document: everything between its root tags.
-fn inner(svg: &str) -> &str {
-    let start = svg
-        .find("<svg")
-        .and_then(|i| svg[i..].find('>').map(|j| i + j + 1));
-    let end = svg.rfind("</svg>");
-    match (start, end) {
-        (Some(s), Some(e)) if s <= e => &svg[s..e],
-        _ => "",
-    }
+/// The shipped `style` in the sample `sketch_path`, as SVG text.
+fn fill(style: &str, sketch_path: &Path) -> Result<String, Box<dyn std::error::Error>> {
+    let style = Library::shipped().load(style, &StyleOptions::default())?;
+    let sketch = Sketch::from_svg(&std::fs::read(sketch_path)?)?;
+    Ok(flourish::fill(&sketch, &style, &FillOptions::default())?.to_svg())
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = root();
     for (style, sample) in [("knot", "circle"), ("scales", "combed")] {
         let tile = std::fs::read_to_string(root.join(format!("styles/{style}/tile.svg")))?;
         let sketch_path = root.join(format!("samples/fill/{sample}.svg"));
         let sketch = std::fs::read_to_string(&sketch_path)?;
-        let opts = FillOptions {
-            style: style.into(),
-            ..FillOptions::default()
-        };
-        let result = run(&opts, &sketch_path)?.to_svg();
+        let result = fill(style, &sketch_path)?;
         let mut tiles = String::new();
         for j in 0..3 {
             for i in 0..3 {
@@ -56,12 +47,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut cells = String::new();
     for (j, style) in styles.iter().enumerate() {
         for (i, shape) in shapes.iter().enumerate() {
-            let opts = FillOptions {
-                style: (*style).into(),
-                ..FillOptions::default()
-            };
             let sketch_path = root.join(format!("samples/fill/{shape}.svg"));
-            let result = run(&opts, &sketch_path)?.to_svg();
+            let result = fill(style, &sketch_path)?;
             cells += &cell(i * 200, j * 200, 200, inner(&result));
         }
     }
@@ -81,9 +68,7 @@ fn cell(x: usize, y: usize, size: usize, body: &str) -> String {
 
 /// Renders SVG text `svg` at `width` px wide into the PNG file `out`.
 fn write_png(out: &Path, svg: &str, width: u32) -> Result<(), Box<dyn std::error::Error>> {
-    let tree = flourish::read::svg::parse_svg(out, svg.as_bytes())?;
-    let pixmap = render_tree(out, &tree, Some(width), None)?;
-    std::fs::write(out, pixmap.encode_png()?)?;
+    std::fs::write(out, render_png(svg, Some(width), None)?)?;
     println!("{}", out.display());
     Ok(())
 }

@@ -4,7 +4,7 @@
 //! Run: `cargo run --example make_pattern_styles` (writes `styles/` and
 //! `samples/pattern/` under the crate root).
 
-use flourish::rng::unit;
+use flourish_tools::unit;
 use std::f64::consts::PI;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -207,7 +207,7 @@ M250 160a40 40 0 1 0 -80 0a40 40 0 1 0 80 0Z\" fill=\"#ddd\" fill-rule=\"evenodd
 }
 
 fn main() -> std::io::Result<()> {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/.."));
     let styles = root.join("styles");
     let defs: [(&str, String, &str); 4] = [
         (

@@ -141,7 +141,7 @@ fn star() -> String {
 }
 
 fn main() -> std::io::Result<()> {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/.."));
     // The source direction is that of the tile's own bands (Brushables
     // §3.1), so a curving field bends the bands along it. The knot's bands
     // run at ±45°: with the x axis as source, a circle's ring-shaped field

@@ -1,15 +1,29 @@
-//! End-to-end properties of `flourish trace` on the project's own sample
-//! images (samples/trace/), and the golden files in golden/trace/.
+//! Properties of the tracer on the project's own sample images
+//! (samples/trace/): curves within tolerance of their reference, renders
+//! that reproduce the bitmap, colour layers, hairlines, apexes, specks,
+//! photographed drawings, dense drawings and random bitmaps.
 
-use flourish::read::ink::{load, InputOptions};
-use flourish::trace::{trace_file, trace_ink, trace_sdf, TraceOptions};
-use flourish::{diff, render};
+use super::{trace_sdf, TraceOptions};
+use crate::read::ink::load;
+use crate::read::ImageOptions;
+use crate::render;
+use crate::svg_out::Document;
 use kurbo::{ParamCurve, PathSeg};
 use proptest::prelude::*;
 use std::path::{Path, PathBuf};
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The document [`super::trace_file`] makes of `path`.
+fn trace_file(path: &Path, input: &ImageOptions, opts: &TraceOptions) -> crate::Result<Document> {
+    super::trace_file(path, input, opts).map(|o| o.document)
+}
+
+/// The document [`super::trace_ink`] makes of `ink`.
+fn trace_ink(ink: &crate::read::ink::Ink, opts: &TraceOptions) -> crate::Result<Document> {
+    super::trace_ink(ink, opts).map(|o| o.document)
 }
 
 fn samples() -> Vec<PathBuf> {
@@ -33,7 +47,7 @@ fn samples() -> Vec<PathBuf> {
 fn fitted_curves_stay_within_tolerance_of_the_level_set() {
     let opts = TraceOptions::default();
     for path in samples() {
-        let ink = load(&path, &InputOptions::default()).expect("sample loads");
+        let ink = load(&path, &ImageOptions::default()).expect("sample loads");
         for layer in &ink.layers {
             let sdf = &layer.sdf;
             let to_px = sdf.to_user.inverse();
@@ -92,9 +106,8 @@ fn displaced_artwork_iou(svg: &Path, input: &[bool], side: u32, shift: f64) -> f
                 shift * a.sin(),
                 &text[open..close]
             );
-            let tree = flourish::read::svg::parse_svg(svg, moved.as_bytes())
-                .expect("moved artwork parses");
-            let pix = render::render_tree(svg, &tree, Some(side), Some([255, 255, 255, 255]))
+            let tree = crate::read::svg::parse_svg(moved.as_bytes()).expect("moved artwork parses");
+            let pix = render::render_tree(&tree, Some(side), Some([255, 255, 255, 255]))
                 .expect("renders");
             let out: Vec<bool> = pix.data().chunks(4).map(|p| p[0] < 128).collect();
             assert_eq!(out.len(), input.len(), "{}: render size", svg.display());
@@ -127,11 +140,10 @@ fn rendered_output_reproduces_the_bitmap() {
             min_area: 0.0,
             ..TraceOptions::default()
         };
-        let doc = trace_file(&path, &InputOptions::default(), &opts).expect("traces");
+        let doc = trace_file(&path, &ImageOptions::default(), &opts).expect("traces");
         let svg = doc.to_svg();
-        let tree = flourish::read::svg::parse_svg(&path, svg.as_bytes()).expect("output parses");
-        let pix =
-            render::render_tree(&path, &tree, None, Some([255, 255, 255, 255])).expect("renders");
+        let tree = crate::read::svg::parse_svg(svg.as_bytes()).expect("output parses");
+        let pix = render::render_tree(&tree, None, Some([255, 255, 255, 255])).expect("renders");
         assert_eq!((pix.width(), pix.height()), (img.width(), img.height()));
         let output: Vec<bool> = pix.data().chunks(4).map(|p| p[0] < 128).collect();
         let score = iou(&input, &output);
@@ -200,16 +212,16 @@ fn artwork_displaced_by_a_fiftieth_of_a_pixel_misses_0_99_on_thin_lines() {
 #[test]
 fn colour_layers_stack_back_into_the_picture() {
     let path = root().join("samples/trace/two-colour.png");
-    let input = InputOptions {
+    let input = ImageOptions {
         layers: true,
-        ..InputOptions::default()
+        ..ImageOptions::default()
     };
     let doc = trace_file(&path, &input, &TraceOptions::default()).expect("traces");
     assert!(doc.groups.len() >= 2, "{} layers", doc.groups.len());
     let img = image::open(&path).expect("png").to_rgb8();
     let svg = doc.to_svg();
-    let tree = flourish::read::svg::parse_svg(&path, svg.as_bytes()).expect("parses");
-    let pix = render::render_tree(&path, &tree, None, Some([255, 255, 255, 255])).expect("renders");
+    let tree = crate::read::svg::parse_svg(svg.as_bytes()).expect("parses");
+    let pix = render::render_tree(&tree, None, Some([255, 255, 255, 255])).expect("renders");
     let mut close = 0usize;
     for (p, q) in img.pixels().zip(pix.data().chunks(4)) {
         let d = (0..3)
@@ -230,22 +242,22 @@ fn colour_layers_stack_back_into_the_picture() {
 fn all_inks_trace_to_one_silhouette_as_the_svg_does() {
     let render_trace = |name: &str| -> Vec<bool> {
         let path = root().join("samples/trace").join(name);
-        let input = InputOptions {
+        let input = ImageOptions {
             resolution: 512,
-            ..InputOptions::default()
+            ..ImageOptions::default()
         };
         let doc = trace_file(&path, &input, &TraceOptions::default()).expect("traces");
         assert!(
             doc.groups
                 .iter()
                 .flat_map(|g| &g.shapes)
-                .all(|s| s.fill == Some(flourish::svg_out::Color::BLACK)),
+                .all(|s| s.fill == Some(crate::svg_out::Color::BLACK)),
             "{name}: mixed inks are filled black"
         );
         let svg = doc.to_svg();
-        let tree = flourish::read::svg::parse_svg(&path, svg.as_bytes()).expect("parses");
-        let pix = render::render_tree(&path, &tree, Some(512), Some([255, 255, 255, 255]))
-            .expect("renders");
+        let tree = crate::read::svg::parse_svg(svg.as_bytes()).expect("parses");
+        let pix =
+            render::render_tree(&tree, Some(512), Some([255, 255, 255, 255])).expect("renders");
         pix.data().chunks(4).map(|p| p[0] < 128).collect()
     };
     let (raster, vector) = (
@@ -270,53 +282,12 @@ fn output_does_not_depend_on_thread_count() {
             .build()
             .expect("pool");
         pool.install(|| {
-            trace_file(&path, &InputOptions::default(), &TraceOptions::default())
+            trace_file(&path, &ImageOptions::default(), &TraceOptions::default())
                 .expect("traces")
                 .to_svg()
         })
     };
     assert_eq!(run(1), run(2));
-}
-
-/// samples/trace/* traced with default options equal golden/trace/*.svg
-/// byte for byte. A failure writes expected | mask | actual to
-/// golden/.failed/; UPDATE_GOLDEN=1 regenerates.
-#[test]
-fn golden_traces() {
-    let update = std::env::var("UPDATE_GOLDEN").is_ok_and(|v| v == "1");
-    let gold = root().join("golden/trace");
-    let failed_dir = root().join("golden/.failed");
-    std::fs::create_dir_all(&gold).expect("golden dir");
-    let mut failures = Vec::new();
-    for path in samples() {
-        let stem = path.file_stem().unwrap().to_string_lossy().to_string();
-        let ext = path.extension().unwrap().to_string_lossy().to_string();
-        let name = format!("{stem}-{ext}.svg");
-        let svg = trace_file(&path, &InputOptions::default(), &TraceOptions::default())
-            .expect("traces")
-            .to_svg();
-        let target = gold.join(&name);
-        if update {
-            std::fs::write(&target, &svg).expect("write golden");
-            continue;
-        }
-        let expected = std::fs::read(&target)
-            .unwrap_or_else(|_| panic!("{} missing: run `make golden`", target.display()));
-        if expected != svg.as_bytes() {
-            std::fs::create_dir_all(&failed_dir).expect("failed dir");
-            if let Ok(report) =
-                diff::diff_svg_texts(&target, &expected, Path::new(&name), svg.as_bytes())
-            {
-                let _ = diff::write_panels(&report, &failed_dir.join(format!("{stem}-{ext}.png")));
-            }
-            let _ = std::fs::write(failed_dir.join(&name), &svg);
-            failures.push(name);
-        }
-    }
-    assert!(
-        failures.is_empty(),
-        "golden mismatch (see golden/.failed/): {failures:?}"
-    );
 }
 
 proptest! {
@@ -336,7 +307,7 @@ proptest! {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("r.png");
         img.save(&p).unwrap();
-        let ink = load(&p, &InputOptions::default()).unwrap();
+        let ink = load(&p, &ImageOptions::default()).unwrap();
         let doc = trace_ink(&ink, &TraceOptions { tolerance: 0.25, min_area: 0.0 }).unwrap();
         for g in &doc.groups {
             for s in &g.shapes {
@@ -354,7 +325,7 @@ proptest! {
             }
         }
         let svg = doc.to_svg();
-        prop_assert!(flourish::read::svg::parse_svg(&p, svg.as_bytes()).is_ok());
+        prop_assert!(crate::read::svg::parse_svg(svg.as_bytes()).is_ok());
     }
 }
 
@@ -369,16 +340,16 @@ proptest! {
 /// smoothed loops fitted together.
 #[test]
 fn outline_curves_stay_within_tolerance_of_their_reference() {
-    use flourish::outline::corridor::Corridor;
-    use flourish::outline::smooth::bitmap_loops;
-    use flourish::read::ink::{load_traceable, LayerOutline, Traceable};
-    use flourish::trace::{trace_bitmap, trace_outline};
+    use crate::outline::corridor::Corridor;
+    use crate::outline::smooth::bitmap_loops;
+    use crate::read::ink::{load_traceable, LayerOutline, Traceable};
+    use crate::trace::{trace_bitmap, trace_outline};
     let opts = TraceOptions::default();
     let slack = 0.05;
     for name in ["glyph-a-binary.png", "glyph-a.png", "holes.png"] {
         let path = root().join("samples/trace").join(name);
         let Traceable::Outline(ink) =
-            load_traceable(&path, &InputOptions::default()).expect("sample loads")
+            load_traceable(&path, &ImageOptions::default()).expect("sample loads")
         else {
             panic!("{name}: a bitmap is traced from its outline");
         };
@@ -469,7 +440,7 @@ fn subpaths(paths: &[kurbo::BezPath]) -> Vec<kurbo::BezPath> {
 /// (each half covered) used to trace half as wide.
 #[test]
 fn hairlines_keep_their_weight() {
-    hairlines_keep_their_weight_with(&InputOptions::default());
+    hairlines_keep_their_weight_with(&ImageOptions::default());
 }
 
 /// The same with `--layers`: each quantized colour's coverage goes through
@@ -478,9 +449,9 @@ fn hairlines_keep_their_weight() {
 /// zigzag and the 1-px vertical line when it read each edge on its own).
 #[test]
 fn hairlines_keep_their_weight_in_layers() {
-    hairlines_keep_their_weight_with(&InputOptions {
+    hairlines_keep_their_weight_with(&ImageOptions {
         layers: true,
-        ..InputOptions::default()
+        ..ImageOptions::default()
     });
 }
 
@@ -498,7 +469,7 @@ fn thin_lines_drawn() -> Vec<kurbo::BezPath> {
 }
 
 /// Every closed subpath of a traced document, over all layers.
-fn traced_subpaths(doc: &flourish::svg_out::Document) -> Vec<kurbo::BezPath> {
+fn traced_subpaths(doc: &crate::svg_out::Document) -> Vec<kurbo::BezPath> {
     subpaths(
         &doc.groups
             .iter()
@@ -507,7 +478,7 @@ fn traced_subpaths(doc: &flourish::svg_out::Document) -> Vec<kurbo::BezPath> {
     )
 }
 
-fn hairlines_keep_their_weight_with(input: &InputOptions) {
+fn hairlines_keep_their_weight_with(input: &ImageOptions) {
     use kurbo::Shape;
     let png = root().join("samples/trace/thin-lines.png");
     let lines = thin_lines_drawn();
@@ -559,7 +530,7 @@ fn binary_hairlines_keep_their_weight() {
         x >= 0 && y >= 0 && x < w && y < h && img.get_pixel(x as u32, y as u32)[0] < 128
     };
     let lines = thin_lines_drawn();
-    let doc = trace_file(&png, &InputOptions::default(), &TraceOptions::default()).expect("traces");
+    let doc = trace_file(&png, &ImageOptions::default(), &TraceOptions::default()).expect("traces");
     let traced = traced_subpaths(&doc);
     let mut total = 0.0;
     for line in &lines {
@@ -640,9 +611,9 @@ fn binary_hairlines_keep_their_weight() {
 /// before), a 3-pixel speck goes, and `--min-area 3` keeps it.
 #[test]
 fn specks_are_measured_in_pixels() {
-    use flourish::outline::smooth as binary;
-    use flourish::raster::Grid;
-    use flourish::trace::trace_outline;
+    use crate::outline::smooth as binary;
+    use crate::raster::Grid;
+    use crate::trace::trace_outline;
     // A 2 × 2 dot, a 3-pixel L and an 8 × 8 square with a 2 × 2 hole.
     let ink = |x: usize, y: usize| {
         let dot = (2..4).contains(&x) && (2..4).contains(&y);
@@ -695,7 +666,7 @@ fn anti_aliased_apexes_stay_sharp() {
     use kurbo::{PathEl, Vec2};
     let turn = |a: Vec2, b: Vec2| a.cross(b).atan2(a.dot(b)).abs().to_degrees();
     let png = root().join("samples/trace/thin-lines.png");
-    let doc = trace_file(&png, &InputOptions::default(), &TraceOptions::default()).expect("traces");
+    let doc = trace_file(&png, &ImageOptions::default(), &TraceOptions::default()).expect("traces");
     // Every node of the output with the tangents arriving and leaving.
     let mut nodes: Vec<(kurbo::Point, f64)> = Vec::new();
     for p in traced_subpaths(&doc) {
@@ -805,7 +776,7 @@ fn clipped_and_masked_svg_traces_what_renders() {
         )
         .unwrap();
         let doc =
-            trace_file(&p, &InputOptions::default(), &TraceOptions::default()).expect("traces");
+            trace_file(&p, &ImageOptions::default(), &TraceOptions::default()).expect("traces");
         assert_eq!((doc.width, doc.height), (100.0, 100.0), "{name}");
         let loops = traced_subpaths(&doc);
         assert_eq!(loops.len(), 1, "{name}: {} loops", loops.len());
@@ -828,10 +799,9 @@ fn rendered_svg_leaves_out_the_spine_in_place() {
 <g transform="translate(10 0)"><circle cx="40" cy="50" r="30" fill="#123" clip-path="url(#c)"/></g>
 <path id="spine" d="M5 90 L95 90" stroke="#000" stroke-width="4" fill="none"/>
 </svg>"##;
-    let path = Path::new("exemplar.svg");
-    let tree = flourish::read::svg::parse_svg(path, svg.as_bytes()).expect("parses");
-    let ink = flourish::read::ink::svg_ink(path, &tree, &InputOptions::default(), Some("spine"))
-        .expect("ink");
+    let tree = crate::read::svg::parse_svg(svg.as_bytes()).expect("parses");
+    let ink =
+        crate::read::ink::svg_ink(&tree, &ImageOptions::default(), Some("spine")).expect("ink");
     let doc = trace_ink(&ink, &TraceOptions::default()).expect("traces");
     let loops = traced_subpaths(&doc);
     assert_eq!(loops.len(), 1, "{} loops", loops.len());
@@ -912,13 +882,12 @@ fn a_photographed_drawing_traces_as_the_drawing_under_uneven_light() {
             } else {
                 photo.save(&path).unwrap();
             }
-            let doc = trace_file(&path, &InputOptions::default(), &TraceOptions::default())
+            let doc = trace_file(&path, &ImageOptions::default(), &TraceOptions::default())
                 .expect("traces");
             let svg = doc.to_svg();
-            let tree =
-                flourish::read::svg::parse_svg(&path, svg.as_bytes()).expect("output parses");
-            let pix = render::render_tree(&path, &tree, None, Some([255, 255, 255, 255]))
-                .expect("renders");
+            let tree = crate::read::svg::parse_svg(svg.as_bytes()).expect("output parses");
+            let pix =
+                render::render_tree(&tree, None, Some([255, 255, 255, 255])).expect("renders");
             let got: Vec<bool> = pix.data().chunks(4).map(|p| p[0] < 128).collect();
             let score = iou(&want, &got);
             eprintln!(
@@ -954,9 +923,9 @@ fn layers_of_a_photographed_colour_drawing_are_its_colours() {
     let dir = tempfile::tempdir().unwrap();
     let lit = dir.path().join("photo.png");
     photo.save(&lit).unwrap();
-    let input = InputOptions {
+    let input = ImageOptions {
         layers: true,
-        ..InputOptions::default()
+        ..ImageOptions::default()
     };
     let shapes = |p: &Path| -> Vec<(String, usize)> {
         let doc = trace_file(p, &input, &TraceOptions::default()).expect("traces");
@@ -1026,23 +995,24 @@ fn a_dense_scribble_traces_from_its_render() {
     );
     let p = dir.path().join("scribble.svg");
     std::fs::write(&p, &svg).unwrap();
-    let input = InputOptions {
+    let input = ImageOptions {
         resolution: 512,
-        ..InputOptions::default()
+        ..ImageOptions::default()
     };
     let opts = TraceOptions {
         min_area: 0.0,
         ..TraceOptions::default()
     };
-    let doc = trace_file(&p, &input, &opts).expect("traces");
+    let out = super::trace_file(&p, &input, &opts).expect("traces");
     assert!(
-        doc.notes.iter().any(|n| n.contains("too dense")),
+        out.notes.iter().any(|n| n.contains("too dense")),
         "{:?}",
-        doc.notes
+        out.notes
     );
+    let doc = out.document;
     let render = |text: &str| -> Vec<bool> {
-        let tree = flourish::read::svg::parse_svg(&p, text.as_bytes()).expect("parses");
-        render::render_tree(&p, &tree, Some(512), Some([255, 255, 255, 255]))
+        let tree = crate::read::svg::parse_svg(text.as_bytes()).expect("parses");
+        render::render_tree(&tree, Some(512), Some([255, 255, 255, 255]))
             .expect("renders")
             .data()
             .chunks(4)
@@ -1070,10 +1040,10 @@ fn grainy_paper_keeps_hairlines_whole() {
     let clean_path = root().join("samples/trace/thin-lines.png");
     let side = 4 * image::open(&clean_path).expect("png").width();
     // Renders of an SVG at 4×, cut halfway between white and its ink.
-    let render_4x = |path: &Path, svg: &str| -> Vec<bool> {
-        let tree = flourish::read::svg::parse_svg(path, svg.as_bytes()).expect("parses");
-        let pix = render::render_tree(path, &tree, Some(side), Some([255, 255, 255, 255]))
-            .expect("renders");
+    let render_4x = |_path: &Path, svg: &str| -> Vec<bool> {
+        let tree = crate::read::svg::parse_svg(svg.as_bytes()).expect("parses");
+        let pix =
+            render::render_tree(&tree, Some(side), Some([255, 255, 255, 255])).expect("renders");
         let darkest = pix.data().chunks(4).map(|p| p[0]).min().unwrap_or(0);
         let cut = (255.0 + f64::from(darkest)) / 2.0;
         pix.data()
@@ -1088,7 +1058,7 @@ fn grainy_paper_keeps_hairlines_whole() {
     );
     let score = |path: &Path| {
         let doc =
-            trace_file(path, &InputOptions::default(), &TraceOptions::default()).expect("traces");
+            trace_file(path, &ImageOptions::default(), &TraceOptions::default()).expect("traces");
         let got = render_4x(path, &doc.to_svg());
         (traced_subpaths(&doc).len(), iou(&want, &got))
     };

@@ -1,0 +1,407 @@
+//! Style libraries: finding a style by name on a search path and loading
+//! it as the kind its `style.toml` declares.
+//!
+//! A style is a folder holding `style.toml` and its exemplar files
+//! (SPEC.md, "Style library"). Loading analyses it once: a brush library's
+//! exemplars (DecoBrush §4, cached on disk), a fill style's tile, a pattern
+//! example's elements (Barla et al. §2). A sketch's shapes may name another
+//! style with `data-style="NAME"`; [`Library::load_named`] loads those, and
+//! [`Styles`] hands a mode the default style with them.
+
+use crate::brush::analysis::{AnalysisOptions, BrushStyle};
+use crate::error::{Error, Result};
+use crate::fill::FillStyle;
+use crate::pattern::PatternStyle;
+use crate::read::sketch::{Query, QueryKind, Sketch};
+use crate::read::style::{self as toml, StyleKind, STYLE_FILE};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// How a style is loaded.
+#[derive(Clone, Debug)]
+pub struct StyleOptions {
+    /// Refuse a style of another kind before its exemplars are read
+    /// (default `None`: any kind).
+    pub kind: Option<StyleKind>,
+    /// Fill: the tile's raster size, px on its longest side, in place of
+    /// the style's `resolution` (8..=1024; default `None`: the style's).
+    pub resolution: Option<u32>,
+    /// Brush: the analysis cache folder (default `None`:
+    /// `$FLOURISH_CACHE_DIR`, else the platform's cache folder).
+    pub cache_dir: Option<PathBuf>,
+    /// Brush: read and write the analysis cache (default `true`).
+    pub use_cache: bool,
+}
+
+impl Default for StyleOptions {
+    fn default() -> Self {
+        StyleOptions {
+            kind: None,
+            resolution: None,
+            cache_dir: None,
+            use_cache: true,
+        }
+    }
+}
+
+impl StyleOptions {
+    /// Checks every value's range.
+    pub fn validate(&self) -> Result<()> {
+        if let Some(r) = self.resolution {
+            if !(8..=1024).contains(&r) {
+                return Err(Error::Option {
+                    name: "resolution",
+                    reason: format!("{r} is not in 8..=1024 px"),
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A loaded style: analysed and ready for the mode of its kind. Cloning it
+/// is cheap (the analysis is shared).
+#[derive(Clone, Debug)]
+pub struct Style {
+    name: String,
+    dir: PathBuf,
+    files: Vec<PathBuf>,
+    loaded: Arc<Loaded>,
+}
+
+/// A style's analysis, by kind.
+#[derive(Debug)]
+pub(crate) enum Loaded {
+    Brush(BrushStyle),
+    Fill(FillStyle),
+    Pattern(Arc<PatternStyle>),
+}
+
+impl Style {
+    /// Loads the style in folder `dir`; its name is the folder as given.
+    pub fn load(dir: &Path, opts: &StyleOptions) -> Result<Style> {
+        Self::load_named_as(&dir.display().to_string(), dir, opts)
+    }
+
+    /// Loads the style in `dir`, known by `name` in notes.
+    fn load_named_as(name: &str, dir: &Path, opts: &StyleOptions) -> Result<Style> {
+        opts.validate()?;
+        let manifest = toml::load(dir)?;
+        let kind = manifest.kind;
+        if let Some(want) = opts.kind {
+            wrong_kind(dir, kind, want)?;
+        }
+        let loaded = match kind {
+            StyleKind::Brush => Loaded::Brush(BrushStyle::load(
+                dir,
+                &AnalysisOptions {
+                    cache_dir: opts.cache_dir.clone(),
+                    use_cache: opts.use_cache,
+                    ..AnalysisOptions::default()
+                },
+            )?),
+            StyleKind::Fill => Loaded::Fill(FillStyle::load(dir, opts.resolution)?),
+            StyleKind::Pattern => Loaded::Pattern(Arc::new(PatternStyle::load(dir)?)),
+        };
+        let files = std::iter::once(dir.join(STYLE_FILE))
+            .chain(manifest.exemplar.iter().map(|e| dir.join(&e.file)))
+            .collect();
+        Ok(Style {
+            name: name.to_string(),
+            dir: dir.to_path_buf(),
+            files,
+            loaded: Arc::new(loaded),
+        })
+    }
+
+    /// The name it was loaded by.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Its folder.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// Its files: `style.toml`, then the exemplars it lists.
+    pub fn files(&self) -> &[PathBuf] {
+        &self.files
+    }
+
+    /// What it is for.
+    pub fn kind(&self) -> StyleKind {
+        match &*self.loaded {
+            Loaded::Brush(_) => StyleKind::Brush,
+            Loaded::Fill(_) => StyleKind::Fill,
+            Loaded::Pattern(_) => StyleKind::Pattern,
+        }
+    }
+
+    /// The brush analysis, or the error a brush command gives for
+    /// another kind.
+    pub(crate) fn brush(&self) -> Result<&BrushStyle> {
+        match &*self.loaded {
+            Loaded::Brush(b) => Ok(b),
+            _ => Err(self.refused(StyleKind::Brush)),
+        }
+    }
+
+    /// The fill analysis (see [`Style::brush`]).
+    pub(crate) fn fill(&self) -> Result<&FillStyle> {
+        match &*self.loaded {
+            Loaded::Fill(f) => Ok(f),
+            _ => Err(self.refused(StyleKind::Fill)),
+        }
+    }
+
+    /// The pattern analysis (see [`Style::brush`]).
+    pub(crate) fn pattern(&self) -> Result<&Arc<PatternStyle>> {
+        match &*self.loaded {
+            Loaded::Pattern(p) => Ok(p),
+            _ => Err(self.refused(StyleKind::Pattern)),
+        }
+    }
+
+    fn refused(&self, want: StyleKind) -> Error {
+        match wrong_kind(&self.dir, self.kind(), want) {
+            Err(e) => e,
+            Ok(()) => Error::invalid("the style is of the right kind"),
+        }
+    }
+}
+
+/// The error for a style of kind `is` where `want` is needed, naming its
+/// `style.toml`.
+fn wrong_kind(dir: &Path, is: StyleKind, want: StyleKind) -> Result<()> {
+    if is == want {
+        return Ok(());
+    }
+    Err(Error::invalid(format!(
+        "kind: is \"{}\", this command needs \"{}\"",
+        is.name(),
+        want.name()
+    ))
+    .in_file(dir.join(STYLE_FILE)))
+}
+
+/// The styles a mode decorates a sketch with: `default` for every query,
+/// and for a query whose shape names another with `data-style="NAME"`,
+/// the style loaded under that name.
+#[derive(Clone, Copy, Debug)]
+pub struct Styles<'a> {
+    default: &'a Style,
+    named: Option<&'a BTreeMap<String, Style>>,
+}
+
+impl<'a> Styles<'a> {
+    /// `default`, and `named` for the shapes that name one
+    /// ([`Library::load_named`]).
+    pub fn new(default: &'a Style, named: &'a BTreeMap<String, Style>) -> Self {
+        Styles {
+            default,
+            named: Some(named),
+        }
+    }
+
+    /// The default style.
+    pub(crate) fn default_style(&self) -> &'a Style {
+        self.default
+    }
+
+    /// The style of query `q` and the name it goes by.
+    pub(crate) fn of(&self, q: &Query) -> Result<&'a Style> {
+        match &q.style {
+            None => Ok(self.default),
+            Some(name) => self.named.and_then(|m| m.get(name)).ok_or_else(|| {
+                Error::invalid(format!("data-style \"{name}\" was not loaded")).in_part(&q.id)
+            }),
+        }
+    }
+}
+
+impl<'a> From<&'a Style> for Styles<'a> {
+    fn from(default: &'a Style) -> Self {
+        Styles {
+            default,
+            named: None,
+        }
+    }
+}
+
+/// Where named styles are found: folders searched in order.
+#[derive(Clone, Debug)]
+pub struct Library {
+    dirs: Vec<PathBuf>,
+}
+
+impl Library {
+    /// The library of the folders `dirs`, searched in order.
+    pub fn new<P: Into<PathBuf>>(dirs: impl IntoIterator<Item = P>) -> Library {
+        Library {
+            dirs: dirs.into_iter().map(Into::into).collect(),
+        }
+    }
+
+    /// The styles shipped with flourish (the crate's `styles/` folder).
+    pub fn shipped() -> Library {
+        Library::new([shipped_dir()])
+    }
+
+    /// The folder of `style`: `style` itself when it is a folder holding
+    /// `style.toml`, else the first folder of the library holding a style
+    /// of that name.
+    pub fn find(&self, style: &str) -> Result<PathBuf> {
+        let direct = Path::new(style);
+        if direct.join(STYLE_FILE).is_file() {
+            return Ok(direct.to_path_buf());
+        }
+        let candidates: Vec<PathBuf> = self.dirs.iter().map(|d| d.join(style)).collect();
+        if let Some(found) = candidates.iter().find(|d| d.join(STYLE_FILE).is_file()) {
+            return Ok(found.clone());
+        }
+        let tried: Vec<String> = std::iter::once(direct)
+            .chain(candidates.iter().map(PathBuf::as_path))
+            .map(|d| d.join(STYLE_FILE).display().to_string())
+            .collect();
+        let tried = match tried.as_slice() {
+            [a, b] => format!("neither {a} nor {b} exists"),
+            _ => format!("none of {} exists", tried.join(", ")),
+        };
+        Err(Error::invalid(format!("style not found: {tried}")).in_file(direct))
+    }
+
+    /// Finds `style` ([`Library::find`]) and loads it under that name.
+    pub fn load(&self, style: &str, opts: &StyleOptions) -> Result<Style> {
+        Style::load_named_as(style, &self.find(style)?, opts)
+    }
+
+    /// The styles that the shapes of `sketch` name with
+    /// `data-style="NAME"`, for the queries a mode of `kind` decorates
+    /// (fill: regions; pattern: every query; brush: none), by name. A NAME
+    /// is a bare folder name looked up in the library's folders only, so a
+    /// sketch cannot make flourish read files elsewhere (`/etc`, `../x`);
+    /// errors name the query.
+    pub fn load_named(
+        &self,
+        sketch: &Sketch,
+        kind: StyleKind,
+        opts: &StyleOptions,
+    ) -> Result<BTreeMap<String, Style>> {
+        let mut named = BTreeMap::new();
+        for q in &sketch.queries {
+            let decorated = match (kind, &q.kind) {
+                (StyleKind::Brush, _) => false,
+                (StyleKind::Fill, QueryKind::Region { .. }) => true,
+                (StyleKind::Fill, QueryKind::Path { .. }) => false,
+                (StyleKind::Pattern, _) => true,
+            };
+            let Some(name) = q.style.as_ref().filter(|_| decorated) else {
+                continue;
+            };
+            if !named.contains_key(name) {
+                let dir = self.find_named(&q.id, name)?;
+                named.insert(name.clone(), Style::load_named_as(name, &dir, opts)?);
+            }
+        }
+        Ok(named)
+    }
+
+    /// The folder of a shape's `data-style="NAME"`: NAME must be a bare
+    /// name (no folder separators, not `.` or `..`).
+    fn find_named(&self, query_id: &str, name: &str) -> Result<PathBuf> {
+        let in_query = |reason: String| Error::invalid(reason).in_part(query_id);
+        let mut parts = Path::new(name).components();
+        let bare = matches!(
+            (parts.next(), parts.next()),
+            (Some(std::path::Component::Normal(n)), None) if n == std::ffi::OsStr::new(name)
+        );
+        let folders: Vec<String> = self.dirs.iter().map(|d| d.display().to_string()).collect();
+        if !bare {
+            return Err(in_query(format!(
+                "data-style \"{name}\" is not a style name (a folder name in {}, without slashes)",
+                folders.join(" or ")
+            )));
+        }
+        let candidates: Vec<PathBuf> = self.dirs.iter().map(|d| d.join(name)).collect();
+        if let Some(found) = candidates.iter().find(|d| d.join(STYLE_FILE).is_file()) {
+            return Ok(found.clone());
+        }
+        let missing: Vec<String> = candidates
+            .iter()
+            .map(|d| d.join(STYLE_FILE).display().to_string())
+            .collect();
+        Err(in_query(format!(
+            "data-style \"{name}\": style not found: {} does not exist",
+            missing.join(", ")
+        )))
+    }
+}
+
+/// The crate's own `styles/` folder.
+pub(crate) fn shipped_dir() -> PathBuf {
+    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/styles"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A shape's `data-style` is a name in the library's folders, never a
+    /// path: absolute, relative, parent and empty names are refused with
+    /// the query named; a missing name says so.
+    #[test]
+    fn data_style_is_a_name_in_the_styles_folder() {
+        let lib = Library::shipped();
+        assert_eq!(
+            lib.find_named("q-1", "knot").expect("shipped"),
+            shipped_dir().join("knot")
+        );
+        for bad in [
+            "/etc",
+            "../styles/knot",
+            "knot/",
+            "./knot",
+            "..",
+            ".",
+            "",
+            "a/b",
+        ] {
+            let e = lib.find_named("q-1", bad).expect_err(bad).to_string();
+            assert!(
+                e.starts_with("q-1: data-style") && !e.contains('\n'),
+                "{bad:?}: {e}"
+            );
+        }
+        let e = lib
+            .find_named("q-2", "no-such-style")
+            .expect_err("missing")
+            .to_string();
+        assert!(
+            e.starts_with("q-2: data-style \"no-such-style\": style not found"),
+            "{e}"
+        );
+    }
+
+    /// A name is found in the first folder that holds it; one that no
+    /// folder holds names every place looked.
+    #[test]
+    fn styles_are_found_along_the_search_path() {
+        let tmp = tempfile::tempdir().expect("temp dir");
+        let own = tmp.path().join("knot");
+        std::fs::create_dir_all(&own).expect("folder");
+        std::fs::write(own.join(STYLE_FILE), "kind = \"fill\"\n").expect("writes");
+        let lib = Library::new([tmp.path().to_path_buf(), shipped_dir()]);
+        assert_eq!(lib.find("knot").expect("found"), own);
+        assert_eq!(lib.find("vine").expect("found"), shipped_dir().join("vine"));
+        let e = lib.find("nowhere").expect_err("missing").to_string();
+        assert!(e.starts_with("nowhere: style not found: none of"), "{e}");
+        let e = Library::shipped().find("nowhere").expect_err("missing");
+        assert!(
+            e.to_string()
+                .contains("style not found: neither nowhere/style.toml nor"),
+            "{e}"
+        );
+    }
+}
