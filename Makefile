@@ -3,7 +3,7 @@ CARGO ?= cargo
 BIN := target/release/flourish
 OUT := out
 
-.PHONY: demo test golden bench lint deps clean
+.PHONY: demo test gallery golden bench lint deps clean
 
 # Everything the tests need that cargo does not install: potrace, the
 # reference tracer the trace tests compare against.
@@ -45,6 +45,16 @@ demo:
 test: deps
 	$(CARGO) build --workspace --all-targets
 	$(CARGO) test --tests
+
+# Every mode on the third-party art of ../shared/art (and the shipped
+# styles), measured against each issue's thresholds, with contact sheets
+# and a report in out/gallery/. Fails on a shortfall that is not listed in
+# src/gallery/shortfalls.txt, on a listed one that got worse, and on a
+# listed one that is now met. FLOURISH_GALLERY=fill (or a style name)
+# runs only the matching cases.
+gallery:
+	@test -d ../shared/art || { echo "gallery: ../shared/art is missing"; exit 1; }
+	$(CARGO) test --lib gallery::gallery -- --ignored --nocapture
 
 # Regenerate the golden files; review the diff before committing.
 golden:

@@ -40,6 +40,8 @@ mod diff;
 mod error;
 mod field;
 mod fill;
+#[cfg(test)]
+mod gallery;
 pub mod io;
 mod library;
 mod outline;

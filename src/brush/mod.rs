@@ -29,6 +29,8 @@ pub mod baseline;
 pub mod graphcut;
 pub mod matching;
 pub mod maxflow;
+#[cfg(test)]
+pub(crate) mod measure;
 pub mod output;
 pub mod pipeline;
 pub mod query;

@@ -3,7 +3,8 @@
 //! art-brush baseline, determinism, refinement, and bad input.
 
 use crate::brush::analysis::{AnalysisOptions, BrushStyle};
-use crate::brush::output::{brush_sketch, components, final_layers, smallest_exemplar_component};
+use crate::brush::measure::{at, emd, ink, median, min_branch, structure, thicknesses, Fidelity};
+use crate::brush::output::{brush_sketch, smallest_exemplar_component};
 use crate::brush::pipeline::{brush_query, QueryResult, Settings};
 use crate::brush::synth::{self, Coord, Field, SynthOptions};
 use crate::raster::Grid;
@@ -52,18 +53,6 @@ fn sketch(name: &str) -> crate::read::sketch::Sketch {
         .expect("sample loads")
 }
 
-/// Ink pixels of a query's final layers (the traced SDFs).
-fn ink(style: &BrushStyle, r: &QueryResult) -> Grid<bool> {
-    let layers = final_layers(style, r);
-    let (w, h) = (r.canvas.width, r.canvas.height);
-    Grid::from_fn(w, h, |x, y| layers.iter().any(|(_, g)| g.get(x, y) < 0.0))
-}
-
-/// Sketch position of a canvas pixel centre.
-fn at(r: &QueryResult, x: usize, y: usize) -> Point {
-    r.canvas.to_user() * Point::new(x as f64 + 0.5, y as f64 + 0.5)
-}
-
 #[test]
 fn ink_follows_each_query_and_has_no_debris() {
     let mut failures = Vec::new();
@@ -78,52 +67,13 @@ fn ink_follows_each_query_and_has_no_debris() {
         for s in SAMPLES {
             let out = brush_sketch(style, &sketch(s), &Settings::default()).expect("brushes");
             for r in &out.queries {
-                let mask = ink(style, r);
-                let w = r.spine.width;
-                let pts: Vec<Point> = (0..mask.height())
-                    .flat_map(|y| (0..mask.width()).map(move |x| (x, y)))
-                    .filter(|&(x, y)| mask.get(x, y))
-                    .map(|(x, y)| at(r, x, y))
-                    .collect();
-                // Coverage: ink within half a width of each spine sample.
-                let covered = r
-                    .spine
-                    .samples
-                    .iter()
-                    .filter(|q| pts.iter().any(|p| p.distance(q.pos) <= 0.5 * w))
-                    .count();
-                let frac = covered as f64 / r.spine.samples.len() as f64;
-                // Nothing far: every ink pixel within 1.5 widths of the spine.
-                let far = pts
-                    .iter()
-                    .map(|p| {
-                        r.spine
-                            .samples
-                            .iter()
-                            .map(|q| q.pos.distance(*p))
-                            .fold(f64::MAX, f64::min)
-                    })
-                    .fold(0.0f64, f64::max)
-                    / w;
-                let sizes: Vec<usize> = components(&mask).iter().map(Vec::len).collect();
-                let smallest = sizes.iter().copied().min().unwrap_or(usize::MAX);
-                // No debris: no piece smaller than the exemplars' smallest,
-                // but for the body of a query shorter than every exemplar.
-                let largest = sizes.iter().copied().max().unwrap_or(0);
-                // Nothing cut flat on the canvas's edge: no ink in its
-                // outermost pixels (with a margin of one width, end curls
-                // and outer leaves were cut on 15 of the sample queries).
-                let (cw, ch) = (mask.width(), mask.height());
-                let on_border = (0..cw)
-                    .flat_map(|x| [(x, 0), (x, ch - 1)])
-                    .chain((0..ch).flat_map(|y| [(0, y), (cw - 1, y)]))
-                    .filter(|&(x, y)| mask.get(x, y))
-                    .count();
+                let f = Fidelity::of(r, &ink(style, r));
                 let name = format!("{s}-{st}/{}", r.spine.query_id);
-                eprintln!("{name}: coverage {frac:.3}, farthest ink {far:.2} widths, smallest component {smallest} px (exemplars {min}), {on_border} ink px on the canvas border");
-                let ok =
-                    frac >= 0.95 && far <= 1.5 && smallest >= min.min(largest) && on_border == 0;
-                if !ok {
+                eprintln!(
+                    "{name}: coverage {:.3}, farthest ink {:.2} widths, smallest component {} px (exemplars {min}), {} ink px on the canvas border",
+                    f.coverage, f.farthest, f.smallest, f.on_border
+                );
+                if !f.holds(min) {
                     failures.push(name);
                 }
             }
@@ -184,158 +134,6 @@ fn correction_leaves_an_exact_exemplar_copy_unchanged() {
         synth::correct(style, &mut field, &SynthOptions::default());
         assert_eq!(field, before, "level {level}");
     }
-}
-
-/// Distance to paper of every ink pixel, px, by a two-pass chamfer
-/// transform (3-4 weights / 3; paper and the grid's outside are 0).
-fn paper_distance(mask: &Grid<bool>) -> Grid<f64> {
-    let (w, h) = (mask.width(), mask.height());
-    let big = 1e9f64;
-    let mut d = Grid::from_fn(w, h, |x, y| if mask.get(x, y) { big } else { 0.0 });
-    let fwd = [
-        (-1isize, 0isize, 1.0),
-        (0, -1, 1.0),
-        (-1, -1, 4.0 / 3.0),
-        (1, -1, 4.0 / 3.0),
-    ];
-    for y in 0..h {
-        for x in 0..w {
-            for (dx, dy, c) in fwd {
-                let v = d.get_or(x as isize + dx, y as isize + dy, 0.0) + c;
-                if v < d.get(x, y) {
-                    d.set(x, y, v);
-                }
-            }
-        }
-    }
-    for y in (0..h).rev() {
-        for x in (0..w).rev() {
-            for (dx, dy, c) in fwd {
-                let v = d.get_or(x as isize - dx, y as isize - dy, 0.0) + c;
-                if v < d.get(x, y) {
-                    d.set(x, y, v);
-                }
-            }
-        }
-    }
-    d
-}
-
-/// The line thicknesses of an ink mask: twice the distance to paper at
-/// ridge pixels (ink pixels whose distance is a maximum along x or y), px.
-fn thicknesses(mask: &Grid<bool>) -> Vec<f64> {
-    let d = paper_distance(mask);
-    let mut thick = Vec::new();
-    for y in 0..mask.height() {
-        for x in 0..mask.width() {
-            let v = d.get(x, y);
-            let g = |dx: isize, dy: isize| d.get_or(x as isize + dx, y as isize + dy, 0.0);
-            if v > 0.0 && ((v >= g(-1, 0) && v >= g(1, 0)) || (v >= g(0, -1) && v >= g(0, 1))) {
-                thick.push(2.0 * v);
-            }
-        }
-    }
-    thick
-}
-
-/// What a designer counts along an ornament, by eye.
-#[derive(Clone, Copy, Debug)]
-struct Structure {
-    /// Ink pieces (4-connected components).
-    pieces: usize,
-    /// Line ends: end points of the skeleton pruned by `min_branch`
-    /// ([`crate::fill::continuity::band_ends`]), so spurs thinning grows
-    /// from pixel steps and bumps of an outline are not ends.
-    ends: usize,
-    /// Loops: holes (paper components not touching the canvas border) of at
-    /// least a median line thickness squared.
-    loops: usize,
-}
-
-impl Structure {
-    /// Counted features per stroke width of path length.
-    fn density(&self, width_px: f64, length_px: f64) -> f64 {
-        (self.pieces + self.ends + self.loops) as f64 / (length_px / width_px)
-    }
-}
-
-/// The structure of an ink mask (see [`Structure`]): `min_branch` is the
-/// spur length pruned from the skeleton and `min_hole` the smallest hole
-/// counted as a loop, px and px².
-fn structure(mask: &Grid<bool>, min_branch: usize, min_hole: usize) -> Structure {
-    let (w, h) = (mask.width(), mask.height());
-    // Only drawn elements count: a piece with no pixel whose four
-    // neighbours are ink is under 2 px thick everywhere, a dot left by
-    // rasterizing a hairline tip (as `smallest_exemplar_component` sets
-    // them aside; the scroll's exemplars hold 45 such dots).
-    let mut clean = Grid::new(w, h, false);
-    for c in components(mask) {
-        let deep = c.iter().any(|&i| {
-            let (x, y) = ((i % w) as isize, (i / w) as isize);
-            [(1, 0), (-1, 0), (0, 1), (0, -1)]
-                .iter()
-                .all(|&(dx, dy)| mask.get_or(x + dx, y + dy, false))
-        });
-        if deep {
-            for i in c {
-                clean.set(i % w, i / w, true);
-            }
-        }
-    }
-    let mask = &clean;
-    let everywhere = Grid::new(w, h, true);
-    let ends = crate::fill::continuity::band_ends(mask, &everywhere, min_branch);
-    let paper = mask.map(|v| !v);
-    let loops = components(&paper)
-        .iter()
-        .filter(|c| {
-            c.len() >= min_hole
-                && c.iter().all(|&i| {
-                    let (x, y) = (i % w, i / w);
-                    x > 0 && y > 0 && x + 1 < w && y + 1 < h
-                })
-        })
-        .count();
-    Structure {
-        pieces: components(mask).len(),
-        ends,
-        loops,
-    }
-}
-
-/// Earth mover's distance between two 1-D samples (quantile matching).
-fn emd(a: &[f64], b: &[f64]) -> f64 {
-    let mut a = a.to_vec();
-    let mut b = b.to_vec();
-    a.sort_by(f64::total_cmp);
-    b.sort_by(f64::total_cmp);
-    let n = 200;
-    (0..n)
-        .map(|k| {
-            let q = (k as f64 + 0.5) / n as f64;
-            let pick = |v: &[f64]| v[((q * v.len() as f64) as usize).min(v.len() - 1)];
-            (pick(&a) - pick(&b)).abs()
-        })
-        .sum::<f64>()
-        / n as f64
-}
-
-/// The spur length pruned from skeletons, px: one median line thickness
-/// of the exemplars. A spur that thinning grows from a pixel step or a
-/// bump of an outline runs from the medial axis to the outline, at most
-/// half its line's thickness and a pixel long, so this removes them on
-/// lines up to twice the median thickness; a spike, leaf tip, curl end or
-/// hook that a designer counts sticks out a line thickness or more beyond
-/// the line it grows from.
-fn min_branch(median_thickness: f64) -> usize {
-    median_thickness.round().max(1.0) as usize
-}
-
-/// The median of a sample (0 when empty).
-fn median(v: &[f64]) -> f64 {
-    let mut v = v.to_vec();
-    v.sort_by(f64::total_cmp);
-    v.get(v.len() / 2).copied().unwrap_or(0.0)
 }
 
 #[test]

@@ -1,0 +1,643 @@
+//! The gallery's cases and what each is measured by.
+//!
+//! - fill (art-pattern-level-sets.txt §2–3): no refusal; neither empty nor
+//!   solid; each colour layer's ink within 15 % of the swatch's own; no ink
+//!   outside the region beyond the tracing tolerance; forks of the top
+//!   layer's bands and the regularity of its gaps within 20 % of the
+//!   swatch's own (`fill::continuity`); the finest level's synthesis energy
+//!   below its initialization's.
+//! - pattern (stroke-pattern-synthesis.txt §3): elements placed, their
+//!   nearest-neighbour spacing within 20 % of the example's.
+//! - brush (decobrush.txt §5–7): ink covers 95 % of the path within half
+//!   a width, none beyond 1.5 widths, no piece smaller than the exemplars'
+//!   smallest drawn element, structure density within 30 % of the
+//!   exemplars', line thicknesses closer to the exemplars' than half the
+//!   art brush's distance.
+//! - trace: the render of the output matches the drawing's own render
+//!   (IoU of the ink at the bitmap's size).
+
+use crate::brush::measure::{ink, ExemplarFigures, Fidelity};
+use crate::brush::output::brush_sketch;
+use crate::brush::pipeline::Settings;
+use crate::fill::continuity::{junctions, regular_gaps, tile_gap_area};
+use crate::library::{Style, StyleOptions};
+use crate::raster::Grid;
+use crate::read::sketch;
+use crate::read::style::StyleKind;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// One measured figure of a case and its threshold.
+#[derive(Clone, Debug)]
+pub(super) struct Check {
+    /// Short name, one word (e.g. `ink`, `coverage`).
+    pub(super) name: String,
+    /// The figure; `None` when the case was refused.
+    pub(super) value: Option<f64>,
+    /// Whether it meets its threshold.
+    pub(super) ok: bool,
+    /// Whether a larger figure is better.
+    pub(super) higher_is_better: bool,
+    /// The threshold, in words.
+    pub(super) wanted: String,
+}
+
+impl Check {
+    /// A figure that must be at least `min`.
+    fn at_least(name: &str, value: f64, min: f64) -> Check {
+        Check {
+            name: name.into(),
+            value: Some(value),
+            ok: value >= min,
+            higher_is_better: true,
+            wanted: format!("≥ {min}"),
+        }
+    }
+
+    /// A figure that must be at most `max`.
+    fn at_most(name: &str, value: f64, max: f64) -> Check {
+        Check {
+            name: name.into(),
+            value: Some(value),
+            ok: value <= max,
+            higher_is_better: false,
+            wanted: format!("≤ {max}"),
+        }
+    }
+
+    /// The case did not run: `runs` fails.
+    fn refused() -> Check {
+        Check {
+            name: "runs".into(),
+            value: None,
+            ok: false,
+            higher_is_better: true,
+            wanted: "no refusal".into(),
+        }
+    }
+
+    /// The figure as the report and the list show it.
+    pub(super) fn shown(&self) -> String {
+        match self.value {
+            Some(v) => format!("{v:.4}"),
+            None => "refused".into(),
+        }
+    }
+
+    /// Whether the figure is worse than `listed` by more than `drift`
+    /// (relative, with a floor of 0.001 absolute).
+    pub(super) fn worse_than(&self, listed: f64, drift: f64) -> bool {
+        let Some(v) = self.value else { return true };
+        let slack = (drift * listed.abs()).max(1e-3);
+        if self.higher_is_better {
+            v < listed - slack
+        } else {
+            v > listed + slack
+        }
+    }
+}
+
+/// A finished case.
+#[derive(Clone, Debug)]
+pub(super) struct Case {
+    /// `MODE--STYLE--SKETCH`.
+    pub(super) name: String,
+    /// The style folder (for the sheet's swatch panel).
+    pub(super) style: PathBuf,
+    /// The sketch or bitmap.
+    pub(super) input: PathBuf,
+    /// The output SVG, when it ran.
+    pub(super) output: Option<PathBuf>,
+    /// Why it was refused.
+    pub(super) error: Option<String>,
+    /// Its checks; a refused case has the one failing `runs`.
+    pub(super) checks: Vec<Check>,
+    /// Wall-clock seconds of the mode itself.
+    pub(super) secs: f64,
+}
+
+impl Case {
+    /// One line for the log.
+    pub(super) fn line(&self) -> String {
+        let figures: Vec<String> = self
+            .checks
+            .iter()
+            .map(|c| format!("{} {}{}", c.name, c.shown(), if c.ok { "" } else { "!" }))
+            .collect();
+        let err = self
+            .error
+            .as_deref()
+            .map(|e| format!(" ({e})"))
+            .unwrap_or_default();
+        format!(
+            "{} {:.2} s: {}{err}",
+            self.name,
+            self.secs,
+            figures.join(", ")
+        )
+    }
+}
+
+/// A case to run.
+pub(super) struct Plan {
+    mode: &'static str,
+    style: PathBuf,
+    input: PathBuf,
+}
+
+impl Plan {
+    /// `MODE--STYLE--INPUT`.
+    pub(super) fn name(&self) -> String {
+        let stem = |p: &Path| {
+            p.file_stem()
+                .or_else(|| p.file_name())
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default()
+        };
+        if self.mode == "trace" {
+            format!("trace--{}", stem(&self.input))
+        } else {
+            format!(
+                "{}--{}--{}",
+                self.mode,
+                stem(&self.style),
+                stem(&self.input)
+            )
+        }
+    }
+
+    /// Runs the case, writes its output into `out/MODE/`, and measures it.
+    pub(super) fn run(&self, out: &Path) -> Case {
+        let name = self.name();
+        let t = Instant::now();
+        let result = match self.mode {
+            "fill" => fill(&self.style, &self.input),
+            "pattern" => pattern(&self.style, &self.input),
+            "brush" => brush(&self.style, &self.input),
+            _ => trace(&self.input),
+        };
+        let secs = t.elapsed().as_secs_f64();
+        let mut case = Case {
+            name: name.clone(),
+            style: self.style.clone(),
+            input: self.input.clone(),
+            output: None,
+            error: None,
+            checks: Vec::new(),
+            secs,
+        };
+        match result {
+            Ok((svg, checks)) => {
+                let dir = out.join(self.mode);
+                let _ = std::fs::create_dir_all(&dir);
+                let path = dir.join(format!("{name}.svg"));
+                if std::fs::write(&path, svg).is_ok() {
+                    case.output = Some(path);
+                }
+                case.checks = checks;
+            }
+            Err(e) => {
+                case.error = Some(e.to_string());
+                case.checks = vec![Check::refused()];
+            }
+        }
+        case
+    }
+}
+
+/// The `.svg` files of `dir` whose names start with `prefix`, sorted.
+fn svgs(dir: &Path, prefix: &str) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map(|r| {
+            r.filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| {
+                    p.extension().is_some_and(|e| e == "svg")
+                        && p.file_name()
+                            .is_some_and(|n| n.to_string_lossy().starts_with(prefix))
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    v.sort();
+    v
+}
+
+/// The kind a style folder's `style.toml` declares, read without checking
+/// the rest (a style the library refuses is a case all the same).
+fn kind_of(dir: &Path) -> Option<StyleKind> {
+    #[derive(serde::Deserialize)]
+    struct Kind {
+        kind: StyleKind,
+    }
+    let text = std::fs::read_to_string(dir.join(crate::read::style::STYLE_FILE)).ok()?;
+    toml::from_str::<Kind>(&text).ok().map(|k| k.kind)
+}
+
+/// The style folders of `dir` of `kind`, sorted.
+fn styles(dir: &Path, kind: StyleKind) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map(|r| {
+            r.filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| kind_of(p) == Some(kind))
+                .collect()
+        })
+        .unwrap_or_default();
+    v.sort();
+    v
+}
+
+/// The cases of `mode`: the art's and the shipped styles of its kind on
+/// the art's sketches and the samples.
+pub(super) fn plan(mode: &'static str, art: &Path, root: &Path) -> Vec<Plan> {
+    let cross = |kind: StyleKind, shipped: bool, inputs: Vec<PathBuf>| -> Vec<Plan> {
+        let mut dirs = styles(&art.join("styles"), kind);
+        if shipped {
+            dirs.extend(styles(&root.join("styles"), kind));
+        }
+        dirs.iter()
+            .flat_map(|s| {
+                inputs.iter().map(move |i| Plan {
+                    mode,
+                    style: s.clone(),
+                    input: i.clone(),
+                })
+            })
+            .collect()
+    };
+    match mode {
+        "fill" => {
+            let mut inputs = svgs(&art.join("sketches"), "region-");
+            inputs.extend(
+                ["circle", "star", "letter", "frame", "combed"]
+                    .iter()
+                    .map(|s| root.join("samples/fill").join(format!("{s}.svg"))),
+            );
+            cross(StyleKind::Fill, true, inputs)
+        }
+        "pattern" => cross(StyleKind::Pattern, false, svgs(&art.join("sketches"), "")),
+        "brush" => {
+            let mut inputs = svgs(&art.join("sketches"), "brush-");
+            inputs.extend(
+                svgs(&root.join("samples/brush"), "")
+                    .into_iter()
+                    .filter(|p| !p.to_string_lossy().ends_with("-refine.svg")),
+            );
+            cross(StyleKind::Brush, true, inputs)
+        }
+        _ => {
+            let mut pngs: Vec<PathBuf> = std::fs::read_dir(art.join("trace"))
+                .map(|r| {
+                    r.filter_map(|e| e.ok().map(|e| e.path()))
+                        .filter(|p| p.extension().is_some_and(|e| e == "png"))
+                        .collect()
+                })
+                .unwrap_or_default();
+            pngs.sort();
+            pngs.into_iter()
+                .map(|p| Plan {
+                    mode,
+                    style: PathBuf::new(),
+                    input: p,
+                })
+                .collect()
+        }
+    }
+}
+
+type Outcome = crate::Result<(String, Vec<Check>)>;
+
+fn load(style: &Path) -> crate::Result<Style> {
+    Style::load(
+        style,
+        &StyleOptions {
+            cache_dir: Some(std::env::temp_dir().join("flourish-gallery-cache")),
+            ..StyleOptions::default()
+        },
+    )
+}
+
+/// The worst of `values` (the smallest when larger is better), or `ok`'s
+/// value when there are none.
+fn worst(values: impl Iterator<Item = f64>, higher_is_better: bool, none: f64) -> f64 {
+    values
+        .fold(None, |acc: Option<f64>, v| {
+            Some(match acc {
+                None => v,
+                Some(a) if higher_is_better => a.min(v),
+                Some(a) => a.max(v),
+            })
+        })
+        .unwrap_or(none)
+}
+
+/// Forks of the top layer's bands per 10⁴ px and the share of regular
+/// gaps of the bottom layer, where `counted` (the tile's centre copy, or
+/// the region's inside more than 6 px from its outline).
+fn continuity(
+    bottom: &Grid<bool>,
+    top: &Grid<bool>,
+    counted: &Grid<bool>,
+    gap: f64,
+) -> (f64, Option<f64>) {
+    let area = counted.data().iter().filter(|&&c| c).count().max(1) as f64;
+    let forks = junctions(top, counted, 4) as f64 * 1e4 / area;
+    let paper = Grid::from_fn(bottom.width(), bottom.height(), |x, y| !bottom.get(x, y));
+    let gaps = (gap > 0.0).then(|| regular_gaps(&paper, counted, gap, 1.6));
+    (forks, gaps)
+}
+
+fn fill(style: &Path, input: &Path) -> Outcome {
+    let st = load(style)?;
+    let fs = st.fill()?;
+    let sk = sketch::load(input)?;
+    let out = crate::fill::fill_sketch(
+        &sk,
+        |_| Ok((st.name(), fs)),
+        &crate::fill::FillOptions::default(),
+    )?;
+    let svg = out.to_document().to_svg();
+    let tile = &fs.tile;
+    let nl = tile.layers.len();
+    // The swatch's own figures on its 3 × 3 repetition's centre copy.
+    let (tw, th) = (tile.width(), tile.height());
+    let rep = |k: usize| {
+        Grid::from_fn(3 * tw, 3 * th, |x, y| {
+            tile.layers[k].sdf.get(x % tw, y % th) < 0.0
+        })
+    };
+    let centre = Grid::from_fn(3 * tw, 3 * th, |x, y| {
+        (tw..2 * tw).contains(&x) && (th..2 * th).contains(&y)
+    });
+    let gap = tile_gap_area(&tile.layers[0].sdf.map(|d| d >= 0.0));
+    let (tile_forks, tile_gaps) = continuity(&rep(0), &rep(nl - 1), &centre, gap);
+    let mut ink_err: Vec<f64> = Vec::new();
+    let mut blank: Vec<f64> = Vec::new();
+    let mut outside: Vec<f64> = Vec::new();
+    let mut forks: Vec<f64> = Vec::new();
+    let mut gaps: Vec<f64> = Vec::new();
+    let mut energy: Vec<f64> = Vec::new();
+    for r in &out.regions {
+        let mask = &r.region.mask;
+        let area = r.region.area.max(1) as f64;
+        let fraction = |k: usize| {
+            r.layers[k]
+                .data()
+                .iter()
+                .zip(mask.data())
+                .filter(|(d, m)| **m && **d < 0.0)
+                .count() as f64
+                / area
+        };
+        for k in 0..nl {
+            let own = tile.ink_fraction(k);
+            if own >= 0.01 {
+                ink_err.push((fraction(k) / own - 1.0).abs());
+            }
+        }
+        let f = fraction(0);
+        blank.push(f.min(1.0 - f));
+        // Curve points outside the region, region px beyond its outline.
+        let to_px = r.region.sdf.to_user.inverse();
+        let far = r
+            .paths
+            .iter()
+            .flatten()
+            .flat_map(|p| p.segments())
+            .flat_map(|s| (0..8).map(move |k| kurbo::ParamCurve::eval(&s, k as f64 / 8.0)))
+            .map(|p| r.region.sdf.value(to_px * p))
+            .fold(0.0f64, f64::max);
+        outside.push(far);
+        let (w, h) = (mask.width(), mask.height());
+        let counted = r.region.sdf.dist.map(|d| d < -6.0);
+        let layer =
+            |k: usize| Grid::from_fn(w, h, |x, y| mask.get(x, y) && r.layers[k].get(x, y) < 0.0);
+        let (fk, gp) = continuity(&layer(0), &layer(nl - 1), &counted, gap);
+        forks.push((fk - tile_forks).abs() / tile_forks.max(1.0));
+        if let (Some(g), Some(t)) = (gp, tile_gaps) {
+            if t > 0.0 {
+                gaps.push(g / t);
+            }
+        }
+        if let Some(fine) = r.energy.last() {
+            if let (Some(&first), Some(&last)) = (fine.first(), fine.last()) {
+                energy.push(last / first.max(1e-12));
+            }
+        }
+    }
+    let mut checks = vec![
+        Check::at_least("blank", worst(blank.into_iter(), true, 0.0), 0.02),
+        Check::at_most("ink", worst(ink_err.into_iter(), false, 0.0), 0.15),
+        Check::at_most("outside", worst(outside.into_iter(), false, 0.0), 0.5),
+        Check::at_most("forks", worst(forks.into_iter(), false, 0.0), 0.2),
+    ];
+    if !gaps.is_empty() {
+        checks.push(Check::at_least(
+            "gaps",
+            worst(gaps.into_iter(), true, 1.0),
+            0.8,
+        ));
+    }
+    checks.push(Check::at_most(
+        "energy",
+        worst(energy.into_iter(), false, 0.0),
+        0.9999,
+    ));
+    Ok((svg, checks))
+}
+
+/// Mean distance from each point to its nearest other point.
+fn mean_nearest(pts: &[kurbo::Point]) -> Option<f64> {
+    if pts.len() < 2 {
+        return None;
+    }
+    let sum: f64 = pts
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            pts.iter()
+                .enumerate()
+                .filter(|&(j, _)| j != i)
+                .map(|(_, q)| p.distance(*q))
+                .fold(f64::MAX, f64::min)
+        })
+        .sum();
+    Some(sum / pts.len() as f64)
+}
+
+fn pattern(style: &Path, input: &Path) -> Outcome {
+    let st = load(style)?;
+    let ps = st.pattern()?.clone();
+    let sk = sketch::load(input)?;
+    let out = crate::pattern::synthesize_sketch(
+        &sk,
+        |_| Ok(ps.clone()),
+        &crate::pattern::PatternOptions::default(),
+    )?;
+    let svg = out.to_document().to_svg();
+    let own = mean_nearest(&ps.reference.dist.centres).unwrap_or(0.0);
+    let mut spacing = Vec::new();
+    let mut placed = f64::INFINITY;
+    for q in &out.queries {
+        let centres: Vec<kurbo::Point> = q.elements.iter().map(|e| e.centre).collect();
+        placed = placed.min(centres.len() as f64);
+        if let Some(m) = mean_nearest(&centres) {
+            spacing.push((m / own - 1.0).abs());
+        }
+    }
+    Ok((
+        svg,
+        vec![
+            Check::at_least("placed", placed, 2.0),
+            Check::at_most("spacing", worst(spacing.into_iter(), false, 0.0), 0.2),
+        ],
+    ))
+}
+
+fn brush(style: &Path, input: &Path) -> Outcome {
+    let st = load(style)?;
+    let bs = st.brush()?;
+    let sk = sketch::load(input)?;
+    let keep = Settings {
+        discard_fields: false,
+        ..Settings::default()
+    };
+    let out = brush_sketch(bs, &sk, &keep)?;
+    let art = brush_sketch(
+        bs,
+        &sk,
+        &Settings {
+            art_brush: true,
+            ..keep.clone()
+        },
+    )?;
+    let figures = ExemplarFigures::of(bs);
+    let (mut coverage, mut far, mut debris, mut density, mut thickness) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for (r, a) in out.queries.iter().zip(&art.queries) {
+        let mask = ink(bs, r);
+        let f = Fidelity::of(r, &mask);
+        coverage.push(f.coverage);
+        far.push(f.farthest);
+        debris.push(
+            f.smallest.min(usize::MAX >> 1) as f64 / figures.smallest.min(f.largest).max(1) as f64,
+        );
+        density.push((figures.density_of(r, &mask) / figures.density.max(1e-9) - 1.0).abs());
+        let own = figures.thickness_distance(&mask);
+        let stretched = figures.thickness_distance(&ink(bs, a));
+        thickness.push(own / stretched.max(1e-9));
+    }
+    Ok((
+        out.document.to_svg(),
+        vec![
+            Check::at_least("coverage", worst(coverage.into_iter(), true, 0.0), 0.95),
+            Check::at_most("farthest", worst(far.into_iter(), false, 0.0), 1.5),
+            Check::at_least("debris", worst(debris.into_iter(), true, 1.0), 1.0),
+            Check::at_most("density", worst(density.into_iter(), false, 0.0), 0.3),
+            Check::at_most("thickness", worst(thickness.into_iter(), false, 0.0), 0.5),
+        ],
+    ))
+}
+
+/// Ink pixels of an SVG rendered `w` × `h` px (dark or opaque enough:
+/// alpha-weighted darkness over ½).
+fn rendered_ink(svg: &[u8], w: u32, h: u32) -> crate::Result<Vec<bool>> {
+    let tree = crate::read::svg::parse_svg(svg)?;
+    let size = tree.size();
+    let mut pixmap =
+        resvg::tiny_skia::Pixmap::new(w, h).ok_or_else(|| crate::Error::invalid("empty render"))?;
+    let t =
+        resvg::tiny_skia::Transform::from_scale(w as f32 / size.width(), h as f32 / size.height());
+    resvg::render(&tree, t, &mut pixmap.as_mut());
+    Ok(pixmap
+        .pixels()
+        .iter()
+        .map(|p| {
+            let c = p.demultiply();
+            let dark = 1.0 - (c.red() as f32 + c.green() as f32 + c.blue() as f32) / 765.0;
+            dark * c.alpha() as f32 / 255.0 > 0.25
+        })
+        .collect())
+}
+
+/// Distinct fill colours of an SVG's text (`fill="#rrggbb"`).
+fn fill_colours(svg: &str) -> usize {
+    let mut seen: Vec<&str> = svg
+        .split("fill=\"#")
+        .skip(1)
+        .filter_map(|r| r.get(..6))
+        .collect();
+    seen.sort_unstable();
+    seen.dedup();
+    seen.len()
+}
+
+/// The F-measure of ink `a` against ink `b` (`w` px wide) with a 1 px
+/// tolerance, as document binarization is scored: a pixel of one counts
+/// as matched when the other has ink within its 3 × 3 neighbourhood.
+fn tolerant_f(a: &[bool], b: &[bool], w: usize) -> f64 {
+    let h = a.len() / w.max(1);
+    let near = |m: &[bool], x: usize, y: usize| {
+        (y.saturating_sub(1)..(y + 2).min(h))
+            .any(|yy| (x.saturating_sub(1)..(x + 2).min(w)).any(|xx| m[yy * w + xx]))
+    };
+    let matched = |p: &[bool], q: &[bool]| {
+        let (mut hit, mut all) = (0usize, 0usize);
+        for y in 0..h {
+            for x in 0..w {
+                if p[y * w + x] {
+                    all += 1;
+                    hit += usize::from(near(q, x, y));
+                }
+            }
+        }
+        hit as f64 / all.max(1) as f64
+    };
+    let (precision, recall) = (matched(a, b), matched(b, a));
+    if precision + recall == 0.0 {
+        0.0
+    } else {
+        2.0 * precision * recall / (precision + recall)
+    }
+}
+
+fn trace(input: &Path) -> Outcome {
+    let bytes = crate::io::read_file(input)?;
+    let truth = std::fs::read_to_string(input.with_extension("svg"))
+        .map_err(|e| crate::Error::io(input.with_extension("svg"), e))?;
+    // A drawing in several inks is traced a layer per colour.
+    let read = crate::ImageOptions {
+        layers: fill_colours(&truth) > 1,
+        ..crate::ImageOptions::default()
+    };
+    let image = crate::Image::from_bytes(&bytes, &read)?;
+    let out = crate::trace(&image, &crate::TraceOptions::default())?;
+    let svg = out.to_svg();
+    let (w, h) = image::image_dimensions(input).map_err(|e| crate::Error::Image(e.to_string()))?;
+    let (a, b) = (
+        rendered_ink(svg.as_bytes(), w, h)?,
+        rendered_ink(truth.as_bytes(), w, h)?,
+    );
+    let f = tolerant_f(&a, &b, w as usize);
+    let segments = out.document.segment_count() as f64;
+    let mut checks = vec![Check {
+        name: "segments".into(),
+        value: Some(segments),
+        ok: true,
+        higher_is_better: false,
+        wanted: "(recorded)".into(),
+    }];
+    // A scan turned by hand does not line up with its drawing.
+    let aligned = !input.to_string_lossy().contains("scanned");
+    checks.push(if aligned {
+        Check::at_least("ink", f, 0.98)
+    } else {
+        Check {
+            name: "ink".into(),
+            value: Some(f),
+            ok: true,
+            higher_is_better: true,
+            wanted: "(recorded: the scan is turned)".into(),
+        }
+    });
+    Ok((svg, checks))
+}
