@@ -17,6 +17,21 @@
 //! stage gets from its dynamic program over polygon vertices (Selinger
 //! 2003, §2.4). Consecutive cubics meet with G1 continuity: both take the
 //! outline's tangent at the join.
+//!
+//! What the curves are held to. An anti-aliased outline is known to a
+//! fraction of a pixel, so curves stay within the accuracy of it. A binary
+//! bitmap's smoothed outline is only one reading of the staircase: the
+//! drawn edge may lie anywhere between the ink and paper pixel centres, so
+//! there a curve point is accepted within the accuracy of the smoothed
+//! outline, or within the accuracy of the corridor
+//! ([`crate::outline::corridor`]: a mixed cell, at least 0.5 − accuracy px
+//! from every pixel centre, so a 1-px line keeps its width and a 1-px gap
+//! stays open) and no further than 0.5 + accuracy px from the smoothed
+//! outline. This is potrace's reading: its polygon may pass anywhere within
+//! half a pixel of the boundary, and opticurve only bounds the curves
+//! against that. `outline_curves_stay_within_tolerance_of_their_reference`
+//! (`src/trace/tests.rs`) checks each sampled curve point against this
+//! reference at tolerance + 0.05 px.
 
 use super::piece::{corner_runs, Guide, Piece};
 use super::span::{append_loop, fit_span, line_cubic, longest_span, CHORD_SHARE, MIN_SPAN_PX};

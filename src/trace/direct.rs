@@ -17,7 +17,20 @@
 //! fitter in the tests). Each candidate is judged by the outline itself: the
 //! outline's samples must lie near the curve and the curve near the
 //! outline (`Piece::holds`), which is all the fitter is held to, so no
-//! separate error measure along normals is needed.
+//! separate error measure along normals is needed (kurbo's fitter measures
+//! each candidate so, and the check would repeat it; SDF contours keep
+//! kurbo's fitter).
+//!
+//! Of the candidates, the best ranked by a rough error ([`rough_error`],
+//! long handles penalised) whose outline samples lie within reach of it,
+//! in arc-length order (a discrete Fréchet test), is flattened into chords
+//! of at most [`CURVE_SPACING`] along its control polygon and checked
+//! against the outline at those points and the midpoints between them, in
+//! one pass. The check is a pure predicate, so a point within the previous
+//! point's slack of the segment that one was found near needs no search
+//! (triangle inequality); the span's samples are taken in order, stepping
+//! along the piece, and given up at the first pair of tangents too sharp
+//! for one cubic.
 
 use super::nearest::nearest_from;
 use super::piece::{Piece, FIT_SAMPLES};

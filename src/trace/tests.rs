@@ -443,10 +443,9 @@ fn hairlines_keep_their_weight() {
     hairlines_keep_their_weight_with(&ImageOptions::default());
 }
 
-/// The same with `--layers`: each quantized colour's coverage goes through
-/// `Sdf::from_coverage` and the contour tracer instead of the direct
-/// outline fit, and must read hairlines the same way (reading each edge
-/// on its own breaks the 1-px zigzag and the 1-px vertical line).
+/// The same with `--layers`: each quantized colour is a layer of its own,
+/// read from its own coverage (its sub-pixel outline, or its bitmap when
+/// binary), and must read hairlines the same way.
 #[test]
 fn hairlines_keep_their_weight_in_layers() {
     hairlines_keep_their_weight_with(&ImageOptions {
