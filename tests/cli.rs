@@ -410,7 +410,8 @@ fn huge_declared_svg_canvas_is_capped_by_resolution() {
 /// Shapes with coordinates of 10¹² or more (far off the canvas, or
 /// crossing it with an edge of nearly zero curvature) trace in moments:
 /// only the parts near the canvas are flattened and measured. (Flattening
-/// a circle of radius 10¹² px to 0.01 px once took minutes and gigabytes.)
+/// a circle of radius 10¹² px to 0.01 px in full would take minutes and
+/// gigabytes.)
 #[test]
 fn svg_shapes_with_huge_coordinates_trace_quickly() {
     let t = tempdir();
@@ -428,9 +429,9 @@ fn svg_shapes_with_huge_coordinates_trace_quickly() {
 
 #[test]
 fn svg_long_stroked_path_traces_quickly() {
-    // A spiral polyline of 100 000 points: its stroke outline's every
-    // segment read every other segment for its winding number (40 000
-    // points took 15 s, 100 000 about 90 s); now under a second or two.
+    // A spiral polyline of 100 000 points: if its stroke outline's every
+    // segment read every other segment for its winding number, it would
+    // take minutes; read band by band, it takes a second or two.
     let t = tempdir();
     let n = 100_000;
     let pts: Vec<String> = (0..n)
@@ -472,8 +473,8 @@ fn directory_as_input_fails_cleanly() {
 
 #[test]
 fn endless_device_as_input_fails_at_the_size_limit() {
-    // /dev/zero has no length to check beforehand: it was read until memory
-    // ran out (gigabytes). Reading stops at the file size limit instead.
+    // /dev/zero has no length to check beforehand: read to its end, it
+    // would fill memory. Reading stops at the file size limit instead.
     let dev = Path::new("/dev/zero");
     if !dev.exists() {
         return;
@@ -1675,10 +1676,10 @@ fn brush_iterations_out_of_range_is_a_usage_error() {
 #[test]
 fn brush_memory_does_not_grow_with_the_number_of_strokes() {
     // Every query's synthesized fields (~2 MB for a short stroke, ~18 MB
-    // for a long one) were kept until the whole sketch was done: 200 tiny
-    // strokes took 540 MB, 5000 ran out of memory and aborted. Now each
-    // query's fields go once it is traced. Run under a 400 MB address
-    // space limit (the run itself needs about 130 MB).
+    // for a long one) go once it is traced: kept until the whole sketch
+    // is done, they would grow with the number of strokes until thousands
+    // of strokes run out of memory. Run under a 400 MB address space
+    // limit (the run itself needs about 130 MB).
     let t = tempdir();
     let mut body = String::new();
     for i in 0..200 {
@@ -1723,9 +1724,10 @@ fn brush_memory_does_not_grow_with_the_number_of_strokes() {
 
 #[test]
 fn data_style_reads_only_the_styles_folder() {
-    // A shape's data-style="/abs/folder" (or "../x") was read as a folder
-    // path, so a sketch could make flourish read any folder's style.toml
-    // and exemplars; a missing one was reported without the sketch's name.
+    // A shape's data-style="/abs/folder" (or "../x") is not read as a
+    // folder path, so a sketch cannot make flourish read any folder's
+    // style.toml and exemplars; a missing one is reported with the
+    // sketch's name.
     let t = tempdir();
     let styles = t.path().join("styles");
     std::fs::create_dir(&styles).unwrap();
@@ -1766,8 +1768,9 @@ fn data_style_reads_only_the_styles_folder() {
 #[test]
 fn brush_thin_diagonal_stroke_is_refused_at_the_canvas_limit() {
     // One stroke 1.45 units wide across a 200-unit sketch: a 7900×7900 px
-    // canvas (under the general 64 Mpx limit) on which the synthesis took
-    // over 7 GB and aborted ("memory allocation failed", exit 134).
+    // canvas (under the general 64 Mpx limit) on which the synthesis
+    // would take over 7 GB and abort ("memory allocation failed", exit
+    // 134).
     let t = tempdir();
     let a = write(
         t.path(),
@@ -1797,7 +1800,7 @@ fn brush_thin_diagonal_stroke_is_refused_at_the_canvas_limit() {
 
 #[test]
 fn file_name_with_a_newline_is_named_on_one_line() {
-    // "new\nline.svg" was printed as is: a two-line error.
+    // "new\nline.svg" printed as is would make a two-line error.
     let t = tempdir();
     let p = write(t.path(), "new\nline.svg", "not an svg");
     let out = t.path().join("out.svg");

@@ -80,7 +80,7 @@ fn flourish_beats_potrace_on_binary_samples() {
 /// How much farther than potrace's flourish's curves may stray from the
 /// true outline, px. A binary bitmap fixes an edge only to ±0.5 px; where
 /// the drawing has a cusp or a 3-px line end, the smooth reading of the
-/// staircase (see `raster::binary`) and potrace's differ by up to this much
+/// staircase (see `outline::smooth`) and potrace's differ by up to this much
 /// in either direction (flourish is closer on three of the four samples).
 const DEVIATION_ALLOWANCE: f64 = 0.2;
 

@@ -157,9 +157,9 @@ pub struct MatchOptions {
     /// Cost of every segment boundary (default 10). Measured on a
     /// 60-width meander, a sample's data term is 0.5–0.75, five samples
     /// per stroke width: a jump must save about three widths of data cost,
-    /// so long coherent pieces win over many short ones (at 2 the doodle
-    /// took 25 segments of 13 samples on average and repeated loops at
-    /// every backward jump; at 10, 14 of 24).
+    /// so long coherent pieces win over many short ones (a small penalty
+    /// cuts a query into many short segments that repeat loops at every
+    /// backward jump).
     pub jump_penalty: f64,
     /// Weight of the squared appearance difference at a boundary (10).
     pub w_appearance: f64,

@@ -7,8 +7,8 @@
 //! source and the sink, an augmenting path is found where they touch, and
 //! the nodes cut off by saturated edges are re-adopted instead of rebuilding
 //! the trees, which makes it fast on 4-connected grids.
-//! [`FlowGraph::max_flow_dinic`] is Dinic's algorithm, kept as the
-//! independent reference the tests compare against (with brute force on
+//! `FlowGraph::max_flow_dinic` (built for tests only) is Dinic's
+//! algorithm, kept as the independent reference the tests compare against (with brute force on
 //! tiny graphs). Capacities are integers, so both are exact.
 
 use std::collections::VecDeque;

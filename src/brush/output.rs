@@ -185,8 +185,20 @@ fn jacobians(style: &BrushStyle, field: &Field) -> Vec<Option<synth::Jacobian>> 
         .collect()
 }
 
-/// [`blended_sdf`] with the field's Jacobians already measured (`jac`,
-/// from [`jacobians`]): the layers of one query share them.
+/// The SDF of the layer of colour `color` (`None`: all ink) read through
+/// a synthesized (already extended) field, px; `PAPER` off the ornament.
+/// Each pixel `p` blends the predictions of its 3×3 neighbourhood:
+/// neighbour `q` predicts the coordinate `μ(q) + J(q)(p − q)` (its patch
+/// continued to `p`, [`synth::jacobian`]) and gives the exemplar's SDF
+/// there (bilinear); the values are averaged with binomial weights 1-2-1
+/// (a neighbour whose exemplar lacks the colour gives paper). Inside a
+/// coherent patch every prediction is `μ(p)` itself and the read is
+/// exact; across a seam the two patches' fields are cross-faded over
+/// three pixels, so outlines cross seams without steps or spurs, and a
+/// lone pixel whose μ landed on another layer's ink (a speck) is outvoted
+/// by its neighbours (the output reading of decobrush.txt §5.4: colours
+/// are read through μ, §7). The field's Jacobians are measured beforehand
+/// (`jac`, from [`jacobians`]): the layers of one query share them.
 fn blended_sdf_with(
     style: &BrushStyle,
     field: &Field,
@@ -331,22 +343,15 @@ pub fn smallest_exemplar_component(style: &BrushStyle) -> usize {
         .unwrap_or(SPECK)
 }
 
-/// The final per-layer canvas SDFs of a query, bottom layer first, with
-/// their colours: each layer read through the continued field with the
-/// blended read ([`blended_sdf`]); then a last, documented cleanup: ink
-/// components smaller than the exemplars' smallest piece
-/// ([`smallest_exemplar_component`], the threshold taken from the style,
-/// not a constant) are synthesis debris and are cleared; the query's
-/// largest piece is its body and always stays.
+/// [`final_layers_with`], measuring the style's facts first.
 #[cfg(test)]
 pub fn final_layers(style: &BrushStyle, r: &QueryResult) -> Vec<(Color, Grid<f32>)> {
     final_layers_with(style, r, &StyleFacts::of(style))
 }
 
 /// What the output stage needs to know about a style, measured once per
-/// sketch instead of once per query (the smallest drawn element scans
-/// every exemplar's finest ink: 45 M instructions, a fifth of a tiny
-/// stroke's whole cost).
+/// sketch instead of once per query: the smallest drawn element scans
+/// every exemplar's finest ink, a large share of a short stroke's cost.
 #[derive(Clone, Debug)]
 struct StyleFacts {
     /// The layer colours ([`palette`]).
@@ -364,7 +369,14 @@ impl StyleFacts {
     }
 }
 
-/// [`final_layers`] with the style's facts already measured.
+/// The final per-layer canvas SDFs of a query, bottom layer first, with
+/// their colours: each layer read through the continued field with the
+/// blended read ([`blended_sdf_with`]); then a last, documented cleanup: ink
+/// components smaller than the exemplars' smallest piece
+/// ([`smallest_exemplar_component`], the threshold taken from the style,
+/// not a constant) are synthesis debris and are cleared; the query's
+/// largest piece is its body and always stays. The style's facts
+/// (`facts`) are measured once per sketch.
 fn final_layers_with(
     style: &BrushStyle,
     r: &QueryResult,
@@ -403,14 +415,14 @@ fn final_layers_with(
     layers
 }
 
-/// Traces a synthesized query into one group of filled shapes, bottom
-/// layer first.
+/// [`trace_query_with`], measuring the style's facts first.
 #[cfg(test)]
 pub fn trace_query(style: &BrushStyle, r: &QueryResult, id: String, opts: &TraceOptions) -> Group {
     trace_query_with(style, r, id, opts, &StyleFacts::of(style))
 }
 
-/// [`trace_query`] with the style's facts already measured.
+/// Traces a synthesized query into one group of filled shapes, bottom
+/// layer first; the style's facts (`facts`) are measured once per sketch.
 fn trace_query_with(
     style: &BrushStyle,
     r: &QueryResult,

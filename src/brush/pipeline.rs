@@ -134,15 +134,15 @@ pub fn start_level(style: &BrushStyle, ew: f64) -> usize {
 
 /// Largest canvas of one brush query, pixels in all (16 Mpx). Synthesis
 /// and tracing hold about 115 bytes per canvas pixel (fields of every
-/// level, Jacobians, layer SDFs), so the general 64 Mpx canvas limit let a
-/// thin diagonal stroke (one 1.45 units wide across a 200-unit sketch, a
-/// 7900×7900 px canvas) take over 7 GB and abort; 16 Mpx is about 1.8 GB,
-/// twenty times the largest canvas of the shipped samples.
+/// level, Jacobians, layer SDFs): under the general 64 Mpx canvas limit
+/// alone a thin diagonal stroke (one 1.45 units wide across a 200-unit
+/// sketch, a 7900×7900 px canvas) would take over 7 GB and abort; 16 Mpx
+/// is about 1.8 GB, twenty times the largest canvas of the shipped samples.
 pub const MAX_BRUSH_PIXELS: u64 = 16 << 20;
 
 /// The canvas of a query spine: its bounding box grown by 1.5 stroke
-/// widths (the farthest an ornament may reach from its spine; with one
-/// width, end curls and outer leaves were cut flat on the canvas border),
+/// widths (the farthest an ornament may reach from its spine; a smaller
+/// margin cuts end curls and outer leaves flat on the canvas border),
 /// at `W_e / W_q` finest pixels per unit, a whole number of coarsest
 /// pixels; checked against the canvas limits (and [`MAX_BRUSH_PIXELS`])
 /// before anything is allocated.

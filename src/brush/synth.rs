@@ -586,8 +586,9 @@ pub fn upsample(style: &BrushStyle, field: &Field) -> Field {
     }
 }
 
-/// [`synthesize`], keeping the corrected field of every level visited,
-/// coarse to fine.
+/// The whole §5.4 pipeline from an initialized coarsest field: correct,
+/// upsample, correct, … up to the finest level of the style, keeping the
+/// corrected field of every level visited, coarse to fine.
 pub fn synthesize_levels(style: &BrushStyle, init: Field, opts: &SynthOptions) -> Vec<Field> {
     let levels = style.exemplars.first().map(|e| e.levels.len()).unwrap_or(1);
     let mut out = Vec::new();

@@ -235,8 +235,13 @@ impl Prepared {
             .unwrap_or(0.0)
     }
 
-    /// [`synthesize_in`] with this tile and parameters and `seed` as the
-    /// seed of every random choice: the same result, bit for bit.
+    /// Synthesizes an image from this tile and parameters whose texture
+    /// follows `direction` (a unit vector per target pixel), searching and
+    /// voting only the neighbourhoods that reach `mask` (the region, same
+    /// size as `direction`; pixels no neighbourhood reaches keep their
+    /// initial values, and energies count only those neighbourhoods), with
+    /// `seed` as the seed of every random choice: the same result, bit for
+    /// bit, whichever regions were filled before.
     pub fn synthesize(
         &self,
         direction: &DirectionGrid,

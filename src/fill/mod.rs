@@ -18,8 +18,8 @@
 //!   region's outline;
 //! - [`levelset`]: narrow-band evolution of the SDF channels;
 //! - [`em`]: the multiresolution loop and voting;
-//! - [`continuity`]: band ends, forks and gap regularity of a result (the
-//!   measure of the tears patch synthesis makes).
+//! - `continuity` (built for tests): band ends, forks and gap regularity
+//!   of a result (the measure of the tears patch synthesis makes).
 //!
 //! Each layer's synthesized SDF is clipped to the region (`max(Φ, Φ_region)`,
 //! exact since both are distances), kept under the layers above it, traced

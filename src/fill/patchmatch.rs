@@ -143,7 +143,7 @@ impl Patch {
 }
 
 /// Nearest integer, halves away from zero (a cast instead of `libm`'s
-/// `round`, which dominated the propagation step).
+/// `round`, which would dominate the propagation step).
 #[inline]
 fn round(v: f32) -> i64 {
     (v + 0.5f32.copysign(v)) as i64
@@ -264,7 +264,7 @@ impl<'a> Problem<'a> {
         Problem::with(source, source_angle, target, target_angle, patch, gather)
     }
 
-    /// [`Problem::new`] with the padded source and gather offsets built
+    /// `Problem::new` (built for tests) with the padded source and gather offsets built
     /// beforehand by [`Gather::new`]`(source, patch)` (shared by every
     /// search against one tile, e.g. all regions of a sketch). A `gather`
     /// of another size or radius is not used: the problem builds its own.

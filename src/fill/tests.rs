@@ -228,7 +228,7 @@ fn a_direction_file_combs_every_region() {
     )
     .unwrap();
     // Under the stroke the field is the stroke's direction (+x); the
-    // boundary flow there was not.
+    // boundary flow there is not.
     let r = &combed.regions[0].region;
     let p = r.sdf.to_user.inverse() * Point::new(100.0, 100.0);
     let d = r.direction.get(p.x as usize, p.y as usize);
@@ -361,8 +361,8 @@ fn the_knot_stays_continuous_under_constant_turning_and_ring_fields() {
     let r = &out.regions[0];
     let (regular, forks) = continuity_of(&r.layers, &r.region.sdf.dist, tile);
     println!("circle: regular gaps {regular:.3}, forks {forks:.2} per 10⁴ px");
-    // (With the tile's x axis as its direction the weave tore into
-    // spirals: 0.906 and 1.54.)
+    // (With the tile's x axis as its direction the weave tears into
+    // spirals.)
     assert!(regular >= 0.93, "circle: {regular}");
     assert!(forks <= 1.2, "circle: {forks}");
 }
@@ -496,11 +496,10 @@ fn the_scales_keep_whole_arcs_in_rows_under_a_constant_field_and_combed() {
     assert!(regular >= 0.95, "constant: {regular}");
     // The combed sample: the wide stroke sets the field over the whole
     // rounded rectangle (its outline's own flow would turn a full circle
-    // around a vortex, which rows of scales cannot follow; under it 0.42
-    // whole arcs, 0.78 regular). Uncombed shapes, the frame with its hole
-    // among them: the style's fixed flow lays the rows straight across
-    // (under the outline's flow the circle gave 0.43 whole arcs and 0.72
-    // regular gaps, the frame 0.47 and 0.72: rows torn around the vortex).
+    // around a vortex, which rows of scales cannot follow). Uncombed
+    // shapes, the frame with its hole among them: the style's fixed flow
+    // lays the rows straight across (under the outline's flow the rows
+    // tear around the vortex).
     for (name, min_whole, min_regular) in [
         ("combed", 0.7, 0.9),
         ("circle", 0.85, 0.95),

@@ -1,6 +1,7 @@
 //! Corners of a closed outline: where it turns sharply within a
 //! pixel-scale window. The fitters cut contours there, so cubics meet at an
-//! angle and sharp corners stay sharp ([`super::fit`], [`super::cover`]).
+//! angle and sharp corners stay sharp ([`crate::trace::fit`],
+//! [`crate::trace::cover`]).
 
 use kurbo::Point;
 
@@ -21,20 +22,18 @@ const CORNER_SEPARATION: f64 = 0.9;
 /// [`CORNER_ANGLE`]: 23°. Only loops under 14 px long notice (a circle
 /// that long turns 32° between the chords to a window either side), where
 /// a round dot's wobbling outline turns past [`CORNER_ANGLE`] within most
-/// windows. Measured on anti-aliased discs, squares and diamonds 1.8–8 px
-/// across at six sub-pixel offsets: no disc gets a corner (0.4 to 0.5
-/// alike); 4-px squares keep all four in five of six (3 of 6 at 0.5);
-/// squares and diamonds under 3 px become round (they were polygons of
-/// 5–7 lines).
+/// windows. On anti-aliased discs, squares and diamonds 1.8–8 px across
+/// at sub-pixel offsets: no disc gets a corner, 4-px squares keep all four
+/// at most offsets, and squares and diamonds under 3 px become round.
 const EXCESS: f64 = 0.4;
 
 /// Indices of the corner vertices of a closed polygon: turning by more
 /// than `CORNER_ANGLE` within ±`CORNER_WINDOW` px, the sharpest vertex
 /// of each such stretch, and by `EXCESS` (0.4 rad) more than a circle of the
 /// loop's length: a dot of the 2 Mpx ornament's dotted rings (1–1.5 px
-/// across) was an octagon of lines between corners found wherever its
-/// outline's wobble peaked, and is now two or three cubics, while a 4-px
-/// square keeps its corners.
+/// across) is two or three cubics, not an octagon of lines between
+/// corners found wherever its outline's wobble peaks, while a 4-px square
+/// keeps its corners.
 pub fn corners(pts: &[Point]) -> Vec<usize> {
     let n = pts.len();
     if n < 4 {
@@ -136,8 +135,8 @@ mod tests {
     const OFFSETS: [(f64, f64); 4] = [(0.3, -0.1), (0.17, 0.41), (0.33, 0.08), (0.45, 0.21)];
 
     /// Round dots 1.8–4 px across have no corners (their outlines, 8–16
-    /// vertices, wobble; the 55° test alone found 2–5 corners on every
-    /// dot under 3.2 px, which then traced as polygons of lines).
+    /// vertices, wobble; the 55° test alone finds corners on every dot
+    /// under about 3 px, which would then trace as polygons of lines).
     #[test]
     fn small_round_dots_have_no_corners() {
         for r in [0.9, 1.1, 1.3, 1.6, 2.0] {

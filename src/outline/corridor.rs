@@ -9,14 +9,14 @@
 //! A curve inside that band renders (thresholded at the pixel centres) to
 //! the same bitmap; the fitter lets curves stray the tolerance beyond it,
 //! and the band does not say on which side of a centre next to two mixed
-//! cells a curve passes, so the output's centres are not all the input's
-//! (2 Mpx ornament: IoU 0.965 sampled at the centres). Holding every
-//! curve to the right side of each centre as well was tried: 3–10× the
-//! segments, and no more than 0.98, as the smoothed outline the curves
-//! follow does not keep to it either. potrace's polygon stage reads
-//! the bitmap the same way: a straight path may pass anywhere within half a
-//! pixel of the boundary (Selinger 2003, §2.2.1), and its curve optimization
-//! only asks the curves to stay within a tolerance of that (§2.4).
+//! cells a curve passes, so the output's centres are not all the input's.
+//! Holding every curve to the right side of each centre as well would
+//! cost several times the segments and still not reach an IoU of 0.99, as
+//! the smoothed outline the curves follow does not keep to it either.
+//! potrace's polygon stage reads the bitmap the same way: a straight path
+//! may pass anywhere within half a pixel of the boundary (Selinger 2003,
+//! §2.2.1), and its curve optimization only asks the curves to stay
+//! within a tolerance of that (§2.4).
 //!
 //! [`Corridor::reaches`] is the acceptance test the fitter uses for binary
 //! outlines ([`crate::trace::cover`]): a curve point is acceptable when a

@@ -216,7 +216,7 @@ const MITRE_OUT: f64 = 1.5;
 /// not something a binary bitmap can show (its edges are uncertain by
 /// half a pixel either way), and as a flat of its own it would cost a
 /// cubic; such a mitre ends in the point in the middle of the cut
-/// instead (on the 2 Mpx ornament, 28 fewer segments).
+/// instead.
 const MIN_CUT: f64 = 1.0;
 
 /// [`MITRE_OUT`] for a concave turn (the notch inside a zigzag's apex),
@@ -295,8 +295,8 @@ pub(super) fn mitre_short_edges(v: Vec<Point>, keep: Vec<bool>) -> (Vec<Point>, 
         };
         // Where the arms' lines meet: next to a thin line's apex the
         // neighbouring edges are a pixel or two long, as its staircase
-        // steps, and point up to 20° off the line (the 2-px zigzag's notch
-        // came out 1.27 px deeper than drawn, 0.94 px along the arms).
+        // steps, and point up to 20° off the line (their lines would put a
+        // thin zigzag's notch deeper than drawn).
         let (d0, d1) = (p - arms.0, arms.1 - q);
         let det = d0.cross(d1);
         if det.abs() < 1e-9 {
@@ -421,10 +421,10 @@ fn turn_deg(a: Point, p: Point, b: Point) -> f64 {
 /// than gathered at an apex: a neighbouring vertex (`neighbours`' turns)
 /// turns the same way by at least half as much, and the two together turn
 /// by less than [`SPREAD_TURN`]. A dot a few pixels across is a
-/// polygon of five to eight vertices turning 45–72° each: as mitres or
-/// bevels each made a corner on a round dot, a kink and a cubic more (on
-/// the 2 Mpx ornament, 3595 → 3344 segments). A square line end's two
-/// vertices turn 90° each, 180° together: still an apex.
+/// polygon of five to eight vertices turning 45–72° each: read as mitres
+/// or bevels, each would make a corner on a round dot, a kink and a cubic
+/// more. A square line end's two vertices turn 90° each, 180° together:
+/// still an apex.
 fn spread(signed: f64, neighbours: [f64; 2]) -> bool {
     let turn = signed.abs();
     neighbours
@@ -502,8 +502,8 @@ mod tests {
             assert_eq!(loops.len(), 1, "width {w}");
             let l = &loops[0];
             // The outline is the rectangle the pixels fill: full length and
-            // width to the last pixel (before, the ends narrowed to a needle
-            // several pixels long, or were rounded off).
+            // width to the last pixel (the ends neither narrow to a needle
+            // several pixels long nor round off).
             let worst = l
                 .points
                 .iter()
@@ -577,8 +577,8 @@ mod tests {
     /// corner at the outer apex, the outline never more than
     /// [`super::MITRE_OUT`] (plus the pixel's own half) beyond the ink. (At
     /// some offsets the pixels next to the apex bend its neighbouring
-    /// edges over to a U-turn of 153°, and the apex came out a round blob
-    /// before the mitre read the arms beyond them, [`super::arm`].)
+    /// edges over to a U-turn of 153°; the mitre reads the arms beyond
+    /// them, [`super::arm`], so the apex does not come out a round blob.)
     #[test]
     fn a_thin_zigzag_apex_is_mitred() {
         for k in 0..16 {
@@ -635,7 +635,7 @@ mod tests {
     /// Round dots 4–14 px across (pixel discs at sub-pixel offsets) come
     /// out without a corner: their polygons turn 45–90° at every vertex,
     /// which the mitre and bevel rules read as apexes unless the turning
-    /// is seen to be spread (`spread`; without it, 8 of these 21 dots had
+    /// is seen to be spread (`spread`; without it, many of these dots get
     /// a corner or two).
     #[test]
     fn round_dots_have_no_corners_and_line_ends_stay_square() {

@@ -25,8 +25,8 @@
 //! which every candidate contains; potrace takes the path's first vertex,
 //! here the start whose greedy cover is shortest among [`START_TRIES`]
 //! spread round the loop (a greedy cover is optimal from a fixed start on
-//! monotone reaches), so the count is never worse than the greedy polygon
-//! flourish used before. From that start, `seg0`/`seg1` bound where the
+//! monotone reaches), so the count is never worse than a greedy
+//! polygon's. From that start, `seg0`/`seg1` bound where the
 //! `j`-th vertex can be and a dynamic programme over them finds the least
 //! total penalty (potrace's `bestpolygon`; linear in practice).
 //!
@@ -40,12 +40,12 @@
 //! candidate starts `k` backwards, so the moments grow by one vertex per
 //! candidate (the first read off prefix sums), and a candidate whose own
 //! total already reaches the best so far is skipped (penalties are ≥ 0).
-//! The value is the one the floating-point prefix sums gave, bit for bit,
-//! wherever those were exact: their terms are multiples of ¼ px², exact
+//! The value is the one floating-point prefix sums give, bit for bit,
+//! wherever those are exact: their terms are multiples of ¼ px², exact
 //! while the sums stay below 2⁵³ quarter units, which holds for the paths
-//! of rasters a few thousand pixels a side (tested on random loops; the 2
-//! Mpx ornament traces byte for byte as before). Beyond that the integer
-//! sums stay exact where the floating-point ones would have rounded.
+//! of rasters a few thousand pixels a side (tested on random loops
+//! against the floating-point reference). Beyond that the integer sums
+//! stay exact where the floating-point ones would round.
 
 mod runs;
 
@@ -64,10 +64,9 @@ pub const STRAIGHT_TOLERANCE: f64 = 0.5;
 /// Longest straight run considered, in path vertices (about 50–70 px of
 /// outline). The penalty search's work grows with the runs' lengths.
 /// Longer runs buy nothing downstream (a straight edge cut in two gets a
-/// smooth vertex on its line, and the curve fitter spans it): at 100 the
-/// 2 Mpx ornament traces byte for byte as at 400 and the binary samples
-/// need the same segments. At 64 a 1.5-px diagonal loses a tenth of its
-/// weight (`binary_hairlines_keep_their_weight`).
+/// smooth vertex on its line, and the curve fitter spans it): the binary
+/// samples trace the same with longer runs. Much shorter runs thin a
+/// 1.5-px diagonal (`binary_hairlines_keep_their_weight`).
 const MAX_RUN: usize = 100;
 
 /// How many starts (spread evenly round the loop) the fewest-segment

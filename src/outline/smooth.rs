@@ -13,11 +13,12 @@
 //!    the bits ([`paths`]).
 //! 2. **Straight runs.** For every vertex `i`, the furthest vertex `j` such
 //!    that a line from `i` passes through the L∞ box of half-side
-//!    [`STRAIGHT_TOLERANCE`] round every vertex between them, every step
-//!    advances along it, and the steps keep to two neighbouring directions
-//!    of the eight (potrace's straight paths, Selinger 2003, §2.2.1, as its
-//!    implementation anchors them; the direction rule keeps a run from
-//!    turning round a line's end). A cone of admissible directions is
+//!    [`STRAIGHT_TOLERANCE`](super::polygon::STRAIGHT_TOLERANCE) round
+//!    every vertex between them, every step advances along it, and the
+//!    steps keep to two neighbouring directions of the eight (potrace's
+//!    straight paths, Selinger 2003, §2.2.1, as its implementation anchors
+//!    them; the direction rule keeps a run from turning round a line's
+//!    end). A cone of admissible directions is
 //!    narrowed from stretch to stretch of repeated steps, in exact integer
 //!    arithmetic on doubled pixel coordinates.
 //! 3. **Optimal polygon** (§2.2.2). Reaches made monotone (every
@@ -25,16 +26,16 @@
 //!    segments round the loop and, of those, the least sum of potrace's
 //!    penalties (chord length × r.m.s. distance of the path from the
 //!    chord), by potrace's dynamic programme from the start whose greedy
-//!    cover is shortest. (Steps 2–3: the private module `raster::polygon`.)
+//!    cover is shortest. (Steps 2–3: [`super::polygon`].)
 //! 4. **Vertex adjustment** (§2.3.1). Each edge gets the least-squares line
 //!    of its path vertices (the interior ones: the ends chamfer the
 //!    corner); each vertex moves to the point of the box of half-side ½
-//!    round its path vertex nearest to its two edges' lines (the private
-//!    module `raster::vertices`). Where the outline makes a U-turn over a
+//!    round its path vertex nearest to its two edges' lines
+//!    ([`super::vertices`]). Where the outline makes a U-turn over a
 //!    vertex or a short edge (the end of a line up to 3½ px wide), the turn
 //!    becomes a square cap at the farthest pixel edge; a short edge at a
 //!    sharp turn (a thin zigzag's apex) becomes a mitre, cut 1.5 px out
-//!    (`super::line_ends`).
+//!    ([`super::line_ends`]).
 //! 5. **Smoothing.** Each vertex becomes either a corner or a cubic from
 //!    the midpoint of its incoming edge to the midpoint of its outgoing
 //!    edge, with control points a fraction `α` of the way to the vertex; `α`
@@ -52,8 +53,8 @@
 //!    Tangents are taken as chords over ±`TANGENT_REACH` px.
 //!
 //! `flourish trace` fits Béziers to these loops directly
-//! ([`smooth_loops`], [`crate::trace::trace_outline`]); other modes that
-//! read a binary bitmap get the SDF of the same curves ([`sdf`]), with the
+//! ([`bitmap_loops`], [`crate::trace::trace_outline`]); other modes that
+//! read a binary bitmap get the SDF of the same curves ([`bitmap_sdf`]), with the
 //! inside of pixel centres taken from the curves (not from the bitmap), so
 //! the sign and the distance agree.
 
@@ -73,10 +74,9 @@ pub const ALPHA_MAX: f64 = 1.0;
 
 /// Flattening tolerance (px) of the smoothed curves. The points are moved
 /// out so the chords straddle the curve ([`smooth_polygon`]), so a coarse
-/// flattening costs no ink: at 0.1 px rather than 0.02 the relaxing and
-/// tangent passes and the fit run over fewer points (2 Mpx ornament: 75 M
-/// fewer instructions per trace, 3669 → 3634 segments, IoU 0.9742 →
-/// 0.9740, binary glyph deviation 0.97 → 1.03 px against potrace's 1.14).
+/// flattening costs no ink, and the relaxing and tangent passes and the
+/// fit run over fewer points than at a fine one, for about the same
+/// segments, IoU and deviation.
 const FLATTEN: f64 = 0.1;
 
 /// One closed loop of a binary bitmap's smoothed outline, flattened: the
@@ -109,7 +109,10 @@ pub fn smooth_loops(cov: &Coverage) -> Vec<SmoothLoop> {
     bitmap_loops(&Bitmap::from_coverage(cov))
 }
 
-/// [`smooth_loops`] of a bitmap's ink.
+/// The smoothed outline of a bitmap's ink as [`SmoothLoop`]s with
+/// tangents and corners: what `flourish trace` fits Béziers to directly.
+/// Outer loops are counter-clockwise in the y-down sense of
+/// [`crate::raster::contour::Contour::signed_area`] > 0, holes the other way.
 pub fn bitmap_loops(bits: &Bitmap) -> Vec<SmoothLoop> {
     paths::paths(bits)
         .par_iter()
@@ -335,8 +338,9 @@ fn relax(l: &mut SmoothLoop) {
 /// Moves a corner-free closed loop out along its normals, by the same
 /// distance everywhere, until it encloses `area` (px², signed) again if
 /// relaxing shrank it. Taubin's second pass undoes the first pass's
-/// shrinking only where the kernel is small beside the loop: a dot of 2×2
-/// pixels (5 px round) shrank to a speck a third of its size.
+/// shrinking only where the kernel is small beside the loop: without this,
+/// a dot of 2×2 pixels (5 px round) would shrink to a speck a third of
+/// its size.
 fn keep_area(points: &mut [Point], area: f64) {
     let n = points.len();
     for _ in 0..2 {
@@ -521,7 +525,8 @@ fn cubic_steps(c: &CubicBez) -> usize {
     ((m / (8.0 * FLATTEN)).sqrt().ceil() as usize).clamp(1, 64)
 }
 
-/// [`sdf`] of a bitmap's ink.
+/// The SDF of a bitmap's ink read as its smoothed outline: distances to
+/// the curves of [`bitmap_loops`], inside taken from the same curves.
 pub fn bitmap_sdf(bits: &Bitmap, to_user: kurbo::Affine) -> Sdf {
     let loops: Vec<Vec<Point>> = bitmap_loops(bits).into_iter().map(|l| l.points).collect();
     let inside = inside(bits.width(), bits.height(), &loops);
@@ -608,8 +613,8 @@ mod tests {
     }
 
     /// A dot of 2×2 pixels, and a hole of 2×2 pixels, stay about a pixel
-    /// round (relaxing shrank the dot to a 0.3-px speck that no cubic could
-    /// fit: 14 polygon segments a tenth of a pixel long).
+    /// round (relaxing alone would shrink the dot to a speck no cubic can
+    /// fit, traced as polygon segments a tenth of a pixel long).
     #[test]
     fn small_dots_and_holes_keep_their_size() {
         let dot: Coverage = Grid::from_fn(10, 10, |x, y| {

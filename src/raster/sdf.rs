@@ -346,9 +346,10 @@ fn link_crossing(cov: &Coverage, l: Link, thin: Option<(&Grid<bool>, &ThinRuns)>
     // The ink lies ahead along the link when its second end is inside. An
     // outside pixel whose edge model's normal (into its ink) points back
     // away from the inside end holds the edge of something beyond it, not
-    // the one crossed here: the faint underside of a line a pixel above a
-    // dot put the dot's top at the faint pixel's centre, a spike a pixel
-    // long (the 2 Mpx anti-aliased ornament's dotted rings).
+    // the one crossed here: read as the dot's, the faint underside of a
+    // line a pixel above a dot would put the dot's top at the faint
+    // pixel's centre, a spike a pixel long (the 2 Mpx anti-aliased
+    // ornament's dotted rings).
     let inside_at = |x: i32, y: i32| {
         thin.map_or(cov.get(x as usize, y as usize) >= 0.5, |(inside, _)| {
             inside.get_or(x as isize, y as isize, false)
@@ -452,8 +453,8 @@ fn thin_run(cov: &Coverage, x: i32, y: i32, dx: i32, dy: i32) -> Option<(i32, i3
 /// The thin run through every pixel along each pixel axis (a run of at
 /// most [`THIN_RUN`] inked pixels, paper or the grid's outside at both
 /// ends), found for all pixels in one pass along the rows and one down the
-/// columns: walking it out from every pixel was half the trace of a 512²
-/// glyph. The walk is kept as the tests' oracle.
+/// columns, rather than walked out from every pixel (which costs a large
+/// share of a trace). The walk is kept as the tests' oracle.
 struct ThinRuns {
     width: usize,
     /// Per pixel: its run along x, if thin, packed by [`ThinRuns::pack`]
@@ -697,10 +698,10 @@ mod tests {
 
     /// A dot a pixel below a thin line (the 2 Mpx anti-aliased ornament's
     /// dotted ring, as rendered): the faint pixel between them holds the
-    /// line's underside, and its edge model, facing the line, once put the
-    /// dot's top at that pixel's centre, a spike a pixel long. The dot's
-    /// outline now stays on its own side of the gap, and the line's
-    /// underside where it was.
+    /// line's underside, and its edge model faces the line; read as the
+    /// dot's, it would put the dot's top at that pixel's centre, a spike a
+    /// pixel long. The dot's outline stays on its own side of the gap, and
+    /// the line's underside where it is.
     #[test]
     fn a_dot_under_a_line_is_not_drawn_up_to_it() {
         // Darkness 0..=255, rows 3..=11 of columns 5..=14 of the render.

@@ -135,9 +135,9 @@ pub(crate) struct FlatShape {
 /// A shape's segments sorted into horizontal bands of its bounding box: a
 /// segment is listed in every band its y-range touches, so the segments
 /// crossing a row `y` are all in the band of `y`. Reading only that band
-/// keeps a winding number from costing every segment of the shape (with
-/// one winding number per segment, a 40 000-segment stroked polyline took
-/// half a minute to trace, quadratically longer as it grew).
+/// keeps a winding number from costing every segment of the shape: with
+/// one winding number per segment, that cost grows with the square of the
+/// segments, which a long stroked polyline makes minutes.
 struct Bands {
     /// Top of the first band, px.
     y0: f64,
@@ -304,8 +304,8 @@ pub(crate) fn scan_inside(w: usize, h: usize, shapes: &[&FlatShape]) -> Grid<boo
 
 /// For each of `shapes`, the others whose boxes meet its box (ascending):
 /// the shapes that can bury its edges. A sweep over the boxes sorted by
-/// their left sides compares only boxes whose x-ranges meet (50 000
-/// scattered dots: 7 M pairs, not 2.5 G).
+/// their left sides compares only boxes whose x-ranges meet, not every
+/// pair, so many scattered small shapes cost about what they hold.
 pub(crate) fn overlapping(shapes: &[&FlatShape]) -> Vec<Vec<usize>> {
     let meet = |a: kurbo::Rect, b: kurbo::Rect| a.intersect(b).area() >= 0.0 && overlaps(a, b);
     let mut order: Vec<usize> = (0..shapes.len()).collect();
@@ -367,7 +367,7 @@ pub(crate) fn union_boundary(shapes: &[&FlatShape], others: &[Vec<usize>]) -> Ve
 }
 
 /// Most segment reads the exact union boundary may take ([`ExactCost`]):
-/// about 2 s on one core. Past it, a drawing's outlines cross so densely
+/// a few seconds on one core. Past it, a drawing's outlines cross so densely
 /// (a scribble of thousands of strokes over the whole canvas, where every
 /// row meets every segment) that the winding numbers would take minutes.
 const MAX_WINDING_READS: u64 = 600_000_000;

@@ -88,7 +88,7 @@ pub enum Traceable {
 }
 
 /// A raster read as the outlines of its ink layers: a binary layer's smooth
-/// outline (see [`super::binary`]), an anti-aliased layer's sub-pixel
+/// outline (see [`crate::outline::smooth`]), an anti-aliased layer's sub-pixel
 /// outline (see [`crate::raster::sdf::subpixel_outline`]).
 #[derive(Clone, Debug)]
 pub struct OutlineInk {
@@ -118,7 +118,7 @@ pub enum LayerOutline {
     /// A binary layer's ink. Its paths are smoothed
     /// ([`crate::outline::smooth::smooth_loop`]) and fitted one at a time, in
     /// parallel, by [`crate::trace::trace_bitmap`], with the corridor
-    /// where its edge may lie ([`super::corridor`]); the smoothed loops
+    /// where its edge may lie ([`crate::outline::corridor`]); the smoothed loops
     /// are never all held at once.
     Bitmap(crate::outline::paths::Bitmap),
     /// An anti-aliased layer's sub-pixel outline, known to a fraction of a

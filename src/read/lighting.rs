@@ -1,5 +1,5 @@
 //! Uneven lighting of a photographed sketch, measured and divided out
-//! before the ink is read (by the raster decoder, `raster::decode`).
+//! before the ink is read (by the raster decoder, [`crate::read::image`]).
 //!
 //! A phone photo of a drawing is brighter where the lamp was and falls off
 //! towards the corners: the paper in a dim corner can be darker than one
@@ -225,9 +225,9 @@ fn fit(samples: &[([f64; TERMS], f64)], keep: &[bool]) -> Option<[f64; TERMS]> {
 /// Each block's paper (0..=1): the level above which lies the brightest
 /// [`PAPER_SHARE`] of its pixels, read on a lattice of every `stride`th
 /// pixel each way (about 16 per block: the light changes over many blocks
-/// and the fit averages them; reading every pixel cost 8 % of a 2 Mpx
-/// trace, 64 per block 5 % of a 512² glyph's). Blocks are
-/// `side` px square (cut short at the right and bottom edges), row by row.
+/// and the fit averages them, so reading more pixels buys nothing and
+/// costs a visible share of a trace). Blocks are `side` px square (cut
+/// short at the right and bottom edges), row by row.
 fn block_paper(
     luma: &(impl Fn(usize, usize) -> u8 + Sync),
     width: usize,

@@ -1,13 +1,10 @@
-//! Style libraries: a folder holding `style.toml` and its exemplar files.
-//!
-//! This module reads and validates `style.toml` ([`StyleToml`]) and finds a
-//! style folder from a `--style` argument ([`resolve`]). Brush libraries are
-//! analysed here, stage by stage: [`exemplar`] (loading, pyramid, SDF
-//! layers), [`spine`] (main branch), [`uv`] (ribs and per-pixel
-//! orientation), the neighbourhood index ([`crate::brush::analysis::neighbourhood`]),
-//! [`cache`], and [`check`] (report and diagnostics sheet); [`brush`] ties
-//! them together ([`brush::BrushStyle::load`]). Pattern styles are analysed
-//! by `pattern::PatternStyle`.
+//! A style's description: `style.toml`, read and validated ([`StyleToml`],
+//! [`load`]). A style is a folder holding `style.toml` and its exemplar
+//! files; finding one by name is [`crate::library::Library::find`], and
+//! analysing it belongs to its mode: a brush library's exemplars in
+//! [`crate::brush::analysis`] ([`crate::brush::analysis::BrushStyle::load`]),
+//! a fill style's tile in [`crate::fill::tile`], a pattern example's
+//! elements in [`crate::pattern::PatternStyle`].
 //!
 //! Every error names the `style.toml` file and, where there is one, the key.
 

@@ -17,6 +17,21 @@
 //! stage gets from its dynamic program over polygon vertices (Selinger
 //! 2003, §2.4). Consecutive cubics meet with G1 continuity: both take the
 //! outline's tangent at the join.
+//!
+//! What the curves are held to. An anti-aliased outline is known to a
+//! fraction of a pixel, so curves stay within the accuracy of it. A binary
+//! bitmap's smoothed outline is only one reading of the staircase: the
+//! drawn edge may lie anywhere between the ink and paper pixel centres, so
+//! there a curve point is accepted within the accuracy of the smoothed
+//! outline, or within the accuracy of the corridor
+//! ([`crate::outline::corridor`]: a mixed cell, at least 0.5 − accuracy px
+//! from every pixel centre, so a 1-px line keeps its width and a 1-px gap
+//! stays open) and no further than 0.5 + accuracy px from the smoothed
+//! outline. This is potrace's reading: its polygon may pass anywhere within
+//! half a pixel of the boundary, and opticurve only bounds the curves
+//! against that. `outline_curves_stay_within_tolerance_of_their_reference`
+//! (`src/trace/tests.rs`) checks each sampled curve point against this
+//! reference at tolerance + 0.05 px.
 
 use super::piece::{corner_runs, Guide, Piece};
 use super::span::{append_loop, fit_span, line_cubic, longest_span, CHORD_SHARE, MIN_SPAN_PX};
@@ -25,9 +40,9 @@ use kurbo::{BezPath, CubicBez, Point, Vec2};
 use rayon::prelude::*;
 
 /// Most turning (radians) one cubic is asked to follow: a half turn, about
-/// what one cubic without an inflection can follow closely (measured over
-/// the samples: 150° cost 2 % more segments, 240° strayed further from the
-/// drawn outline than potrace on the binary scroll).
+/// what one cubic without an inflection can follow closely. A smaller cap
+/// splits spans one cubic could take (more segments); a larger one lets a
+/// cubic stray from the drawn outline.
 pub const MAX_SPAN_TURN: f64 = std::f64::consts::PI;
 
 /// Turning is accumulated between chords of about this many px, which
@@ -36,11 +51,9 @@ const TURN_STEP: f64 = 3.0;
 
 /// The search for the end of a span stops when the bracket between the
 /// longest span that fits and the shortest that does not is below this
-/// share of the span (or half a pixel): 3/16, one bisection step fewer
-/// than an eighth on most spans (fit work −7 % on the 2 Mpx ornament) for
-/// about the same number of cubics (3082 → 3148 there; all samples 5198 →
-/// 5319, 0.79× potrace's, as before the cheap-probe search); a quarter
-/// cost another 5 % of the work and added 2 % more cubics.
+/// share of the span (or half a pixel): 3/16 saves one bisection step
+/// against an eighth on most spans for about the same number of cubics,
+/// while a quarter saves little more work and costs cubics.
 const SEARCH_SHARE: f64 = 0.1875;
 
 /// Fits a closed outline (pixel coordinates) with cubic Béziers within
@@ -180,7 +193,7 @@ fn cover_run(piece: &Piece, accuracy: f64, out: &mut Vec<CubicBez>) {
 /// remainder (under half the span before it) is often one cubic with
 /// that span. When one cubic fits both (`starts`: where they begin, as
 /// shares of the run; `count` cubics were pushed for the run), it
-/// replaces them (2 Mpx ornament: 37 fewer segments).
+/// replaces them.
 fn merge_remainder(
     piece: &Piece,
     starts: [f64; 2],

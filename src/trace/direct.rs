@@ -17,7 +17,20 @@
 //! fitter in the tests). Each candidate is judged by the outline itself: the
 //! outline's samples must lie near the curve and the curve near the
 //! outline (`Piece::holds`), which is all the fitter is held to, so no
-//! separate error measure along normals is needed.
+//! separate error measure along normals is needed (kurbo's fitter measures
+//! each candidate so, and the check would repeat it; SDF contours keep
+//! kurbo's fitter).
+//!
+//! Of the candidates, the best ranked by a rough error ([`rough_error`],
+//! long handles penalised) whose outline samples lie within reach of it,
+//! in arc-length order (a discrete Fréchet test), is flattened into chords
+//! of at most [`CURVE_SPACING`] along its control polygon and checked
+//! against the outline at those points and the midpoints between them, in
+//! one pass. The check is a pure predicate, so a point within the previous
+//! point's slack of the segment that one was found near needs no search
+//! (triangle inequality); the span's samples are taken in order, stepping
+//! along the piece, and given up at the first pair of tangents too sharp
+//! for one cubic.
 
 use super::nearest::nearest_from;
 use super::piece::{Piece, FIT_SAMPLES};
@@ -184,9 +197,9 @@ const CURVE_SPACING: f64 = 0.4;
 /// within the piece's reach of the curve, and the curve within `accuracy`
 /// of the outline (`Piece::holds`, which also admits the corridor), checked
 /// on the best ranked candidate that keeps the samples within reach
-/// (ranked by [`rough_error`], long handles penalised as above; trying the
-/// others in the last check too cost thin-line art accuracy: they are the
-/// loops and hooks).
+/// (ranked by [`rough_error`], long handles penalised as above; the others
+/// are not tried in the last check: they are the loops and hooks, and
+/// would cost thin-line art accuracy).
 pub(super) fn fit_span_direct(
     piece: &Piece,
     range: std::ops::Range<f64>,
@@ -204,9 +217,9 @@ pub(super) fn fit_span_direct(
     // (a few samples against a coarse flattening, see [`rough_error`]):
     // only the best ranked is flattened and measured in full, the next
     // only if it fails. Measuring every candidate in full and keeping the
-    // smallest error picked the same cubic in 89 % of the fits on the
-    // 2 Mpx ornament (most have one candidate that passes), for 3669
-    // cubics there against 3680 now and a quarter of the fit's work.
+    // smallest error picks the same cubic in most fits (most have one
+    // candidate that passes), for about as many cubics and much more of
+    // the fit's work.
     let mut ranked = [(0.0, f64::INFINITY, CubicBez::new(p0, p0, p0, p0)); 4];
     for (r, &(d0, d1)) in ranked.iter_mut().zip(&cands[..k]) {
         let c = CubicBez::new(
@@ -237,12 +250,12 @@ pub(super) fn fit_span_direct(
     // Every point with the midpoints between them, in order: the
     // distance to the outline can grow by half the spacing between two
     // points that pass, which a curve crossing a corner of the outline or
-    // of the corridor uses (a one-handle cubic on the binary glyph 'a'
-    // strayed 0.48 px between points 0.4 px apart). A midpoint within the
-    // slack its neighbour left costs no search (`Piece::holds`). In one
-    // pass: a coarse pass over every eighth point first (each a search of
-    // its own) cost more on the curves that pass, nearly all of those
-    // checked here, than it saved on the few that fail.
+    // of the corridor uses (a one-handle cubic can stray about half a
+    // pixel between points 0.4 px apart). A midpoint within the slack its
+    // neighbour left costs no search (`Piece::holds`). In one pass: a
+    // coarse pass over every eighth point first (each a search of its
+    // own) costs more on the curves that pass, nearly all of those
+    // checked here, than it saves on the few that fail.
     let m = pts.m;
     let fine = (1..2 * m).map(|j| {
         if j % 2 == 0 {

@@ -211,8 +211,7 @@ mod tests {
         // A disc centred on the canvas's top-left corner and one covering
         // the whole canvas: the contour runs along the border, where the
         // SDF is far from zero, and each border stretch must still be one
-        // segment (it was one per marching-squares edge: 800 for the
-        // full canvas).
+        // segment, not one per marching-squares edge.
         for (cx, cy, r, most) in [(0.0, 0.0, 60.0, 8), (50.0, 50.0, 500.0, 12)] {
             let sdf = disc_sdf(100, cx, cy, r);
             let cs = contour::extract(&sdf.dist);

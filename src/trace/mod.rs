@@ -1,11 +1,25 @@
-//! Signed distance fields to compact Bézier outlines — the last stage of
-//! every raster mode, and the `flourish trace` command on its own.
+//! Signed distance fields and exact outlines to compact Bézier outlines —
+//! the last stage of every raster mode, and the `flourish trace` command
+//! on its own.
 //!
-//! Stages: [`contour::extract`] (marching squares on the SDF, sub-pixel
-//! vertices, consistent saddles, closed oriented loops) → [`nest`] (outer
-//! boundaries and their holes; islands and holes under `min_area` dropped)
-//! → [`fit::fit_contour`] (corners found, cubic Béziers fitted by kurbo
-//! within `tolerance`) → transformed to the input's units.
+//! Two roads, one rule: every curve stays within `tolerance` of what it is
+//! fitted to.
+//!
+//! * **SDFs** (an SVG's layers, and the synthesized layers of brush and
+//!   fill, [`trace_sdf`]): [`contour::extract`] (marching squares on the
+//!   SDF, sub-pixel vertices, consistent saddles, closed oriented loops) →
+//!   [`nest`] (outer boundaries and their holes; islands and holes under
+//!   `min_area` dropped) → [`fit::fit_contour`] (corners found, cubic
+//!   Béziers fitted by kurbo, each checked against the SDF's zero level) →
+//!   transformed to the input's units.
+//! * **Outlines** (every ink layer of a raster, [`trace_outline`] and
+//!   [`trace_bitmap`]): no SDF in between. An anti-aliased layer's
+//!   sub-pixel outline, or a binary layer's smoothed outline
+//!   ([`crate::outline::smooth`]), is covered run by run between corners
+//!   by the longest spans one cubic fits ([`cover`]), each cubic matched
+//!   to the outline's area and moment (`direct`) and checked against the
+//!   outline itself, or for a binary layer against the corridor where its
+//!   edge may lie ([`crate::outline::corridor`]).
 //!
 //! DecoBrush (§7, "Vectorization from SDF") left this step to Illustrator;
 //! flourish measures it against potrace (`make bench`).

@@ -220,7 +220,7 @@ pub(super) const CHORD_SHARE: f64 = 0.6;
 /// `accuracy` px, each line also checked against what the piece is fitted
 /// to (Douglas–Peucker). The span is a sharp turn no cubic follows (a thin
 /// line's pointed end, a corner too tight to be found): its flattened
-/// outline alone held 5–10 lines a tenth of a pixel long.
+/// outline alone would be 5–10 lines a tenth of a pixel long.
 pub(super) fn polygon(piece: &Piece, range: Range<f64>, accuracy: f64, out: &mut Vec<CubicBez>) {
     let s0 = range.start * piece.length();
     let s1 = range.end * piece.length();

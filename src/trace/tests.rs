@@ -333,7 +333,7 @@ proptest! {
 /// point sampled on the fitted curves lies within tolerance + 0.05 px of
 /// the reference the fitter is held to. For an anti-aliased bitmap that is
 /// its sub-pixel outline. For a binary bitmap it is the corridor where the
-/// bitmap's edge may lie (`raster::corridor`): within tolerance + 0.05 px
+/// bitmap's edge may lie (`outline::corridor`): within tolerance + 0.05 px
 /// of the smoothed outline, or of the corridor while no further than its
 /// half-width + tolerance + 0.05 px from the smoothed outline. A binary
 /// bitmap is traced path by path (`trace_bitmap`): the same curves as its
@@ -437,16 +437,15 @@ fn subpaths(paths: &[kurbo::BezPath]) -> Vec<kurbo::BezPath> {
 /// sample's twenty lines (1, 1.5, 2 and 3 px wide; straight, diagonal,
 /// zigzag, wave) traces to one unbroken loop whose area is within 15 % of the
 /// drawn line's, 3 % on average. A 1-px line straddling two pixel rows
-/// (each half covered) used to trace half as wide.
+/// (each half covered) keeps its whole width.
 #[test]
 fn hairlines_keep_their_weight() {
     hairlines_keep_their_weight_with(&ImageOptions::default());
 }
 
-/// The same with `--layers`: each quantized colour's coverage goes through
-/// `Sdf::from_coverage` and the contour tracer instead of the direct
-/// outline fit, and must read hairlines the same way (it broke the 1-px
-/// zigzag and the 1-px vertical line when it read each edge on its own).
+/// The same with `--layers`: each quantized colour is a layer of its own,
+/// read from its own coverage (its sub-pixel outline, or its bitmap when
+/// binary), and must read hairlines the same way.
 #[test]
 fn hairlines_keep_their_weight_in_layers() {
     hairlines_keep_their_weight_with(&ImageOptions {
@@ -491,7 +490,7 @@ fn hairlines_keep_their_weight_with(input: &ImageOptions) {
             .iter()
             .filter(|p| bb.inflate(1.0, 1.0).contains(p.bounding_box().center()))
             .collect();
-        // Unbroken: one loop (a 1-px wave used to break at its troughs,
+        // Unbroken: one loop (a 1-px wave must not break at its troughs,
         // where it straddles two rows at 127/255 each).
         assert_eq!(
             pieces.len(),
@@ -607,8 +606,8 @@ fn binary_hairlines_keep_their_weight() {
 
 /// `--min-area` counts a binary bitmap's pixels, as potrace's speck size
 /// does: a 2 × 2 dot and a 2 × 2 pinhole are 4 px² and stay at the default
-/// (their smoothed curves enclose only about 3 px², which dropped them
-/// before), a 3-pixel speck goes, and `--min-area 3` keeps it.
+/// (their smoothed curves enclose only about 3 px², which would drop
+/// them), a 3-pixel speck goes, and `--min-area 3` keeps it.
 #[test]
 fn specks_are_measured_in_pixels() {
     use crate::outline::smooth as binary;
@@ -655,7 +654,7 @@ fn specks_are_measured_in_pixels() {
 
 /// Anti-aliased apexes stay points: half coverage cuts the apexes of a thin
 /// zigzag off (a flat, or a lopsided blunt end), and the tracer puts the
-/// point back (`raster::tips`). At every vertex of the drawn zigzags (16
+/// point back (`outline::tips`). At every vertex of the drawn zigzags (16
 /// apexes turning by 140°, inside and out, 1 to 3 px lines) the traced
 /// outline has one node within 1.25 px that turns by more than 110° (a flat
 /// has two nodes turning by about 70°; the 1-px zigzag's inner apexes land
@@ -852,9 +851,9 @@ fn photographed(
 
 /// A photographed drawing traces as the drawing, not as a shadow: with the
 /// light falling to a third in one corner the paper there is darker than
-/// one half (one threshold over the picture filled that corner with ink),
+/// one half (one threshold over the picture fills that corner with ink),
 /// and the lighting is measured on the paper and divided out first
-/// (`raster::lighting`). Grey PNG and warm-paper JPEG alike, the traced
+/// (`read::lighting`). Grey PNG and warm-paper JPEG alike, the traced
 /// outline renders to the clean drawing's bitmap (IoU) within 0.015 of what
 /// the same photo evenly lit gives (the dim corner's grain is tripled with
 /// it, and its ink and paper lie closer together), and the JPEG keeps its
@@ -968,8 +967,8 @@ fn layers_of_a_photographed_colour_drawing_are_its_colours() {
 
 /// A scribble whose outline segments cross the same rows so densely that
 /// the exact winding numbers would read hundreds of millions of segments
-/// (4000 strokes over the whole height: 60 s at 20 000 points) is read
-/// from its anti-aliased render instead, says so, and its trace still
+/// (4000 strokes over the whole height) is read from its anti-aliased
+/// render instead, says so, and its trace still
 /// reproduces that render.
 #[test]
 fn a_dense_scribble_traces_from_its_render() {
@@ -1029,8 +1028,8 @@ fn a_dense_scribble_traces_from_its_render() {
 
 /// Grainy paper does not break hairlines: the thin-lines drawing
 /// photographed under even light with grain of ±6 to ±15 grey levels per
-/// pixel traces to as many loops as the clean drawing (before the paper's
-/// grain was measured, ±10 broke the 1-px lines into dashes), and its
+/// pixel traces to as many loops as the clean drawing (read without its
+/// grain, ±10 would break the 1-px lines into dashes), and its
 /// outline covers the drawing's artwork as closely as the clean trace's
 /// does: IoU of the two renders at 4× (areas, so a line's width counts,
 /// not which of two half-covered pixels a 50 % cut picks) within 0.03.

@@ -1,10 +1,10 @@
 //! Shared measurement code for comparing `flourish trace` with potrace
-//! (`tests/potrace.rs`, `examples/compare_potrace.rs`).
+//! (`tests/potrace.rs`, `tools/src/bin/compare_potrace.rs`).
 //!
 //! * [`ground_truth`]: the exact outline of a sample's vector art in pixel
 //!   coordinates of its PNG. The samples' PNGs are resvg renders of the SVG
 //!   at its own size with the identity transform (user unit = pixel, see
-//!   `examples/make_trace_samples.rs`), so the SVG's shapes are flattened
+//!   `tools/src/bin/make_trace_samples.rs`), so the SVG's shapes are flattened
 //!   (0.01 px) with their absolute transforms, and the boundary of their
 //!   union is kept: the outlines are cut into pieces of at most 0.5 px, each
 //!   piece is kept when the points just left and right of it (±0.01 px) are

@@ -9,12 +9,12 @@
 //!   strings ([`crate::raster::plain`]) so it loads at memory speed; each
 //!   exemplar and each level's index is its own postcard blob, so they
 //!   decode in parallel.
-//! * Folder: [`AnalysisOptions::cache_dir`](super::brush::AnalysisOptions)
+//! * Folder: [`AnalysisOptions::cache_dir`](super::AnalysisOptions::cache_dir)
 //!   (`--cache DIR`), else `$FLOURISH_CACHE_DIR`, else the platform's cache
 //!   folder (`~/.cache/flourish/styles` on Linux).
 //! * A file that is missing, of another version or key, truncated, corrupt
 //!   or inconsistent (sizes that disagree, see
-//!   [`super::brush::BrushStyle::validate`]) is never trusted: the style is
+//!   [`super::style::BrushStyle::validate`]) is never trusted: the style is
 //!   analysed again and the file rewritten atomically. Failing to write the
 //!   cache (read-only folder) is not an error.
 

@@ -6,7 +6,7 @@
 //!   vector outline ([`crate::read::ink::svg_ink`]); a path with
 //!   `id="spine"` is the hand-drawn main branch and is not ink.
 //! * Raster files through `image`: layers by quantized colour
-//!   ([`crate::read::ink::load_raster`]), resampled to each level's size
+//!   ([`load_raster`]), resampled to each level's size
 //!   by area averaging of their coverage, SDF with sub-pixel edges
 //!   ([`Sdf::from_coverage`]).
 //!

@@ -56,7 +56,7 @@ pub struct Exemplar {
     pub spine_source: SpineSource,
     /// The smooth spine as a dense polyline from start to end, finest px.
     /// The ribs run along it extended straight beyond both ends over the
-    /// end ornaments ([`uv::extend_to_ink`]), by `extension` px.
+    /// end ornaments ([`super::uv::extend_to_ink`]), by `extension` px.
     pub spine: Vec<[f64; 2]>,
     /// How far the ribs extend the spine beyond its start and its end,
     /// finest px.

@@ -60,9 +60,9 @@ fn ink_follows_each_query_and_has_no_debris() {
         let style = style(st);
         let min = smallest_exemplar_component(style);
         // The debris threshold is a drawn element, not a dot left by
-        // rasterizing a hairline tip (the scroll's was 4 px² before such
-        // dots, under 2 px thick everywhere, were set aside): every shipped
-        // exemplar piece is thousands of px².
+        // rasterizing a hairline tip (such dots, under 2 px thick
+        // everywhere, are set aside): every shipped exemplar piece is
+        // thousands of px².
         assert!(min >= 1000, "{st}: smallest exemplar element {min} px²");
         for s in SAMPLES {
             let out = brush_sketch(style, &sketch(s), &Settings::default()).expect("brushes");
@@ -214,7 +214,7 @@ fn flourish_keeps_the_exemplars_structure_where_the_art_brush_drifts() {
         // raise it, a stretched copy lowers it) within 30 %, and at most
         // two thirds of the stretched baseline's drift; its line
         // thicknesses stay the exemplars' where the baseline's drift. The
-        // scroll misses the 30 % (README, "Brush limits"): a long query is
+        // scroll misses the 30 % (docs/brush.md, "Limits"): a long query is
         // mostly exemplar middles, where its spike clusters sit, so it has
         // more line ends per width than the exemplars' whole lengths
         // (about +43 %); it is held to 50 % so a regression still fails.

@@ -1,5 +1,5 @@
-//! Test oracles: the straight runs and the optimal polygon as flourish
-//! computed them before the lattice arithmetic (floating point, the runs
+//! Test oracles: the straight runs and the optimal polygon computed the
+//! plain way, without the lattice arithmetic (floating point, the runs
 //! walked vertex by vertex, the penalty from prefix sums about the start
 //! vertex). The fast code must agree with them exactly.
 

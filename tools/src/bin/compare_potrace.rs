@@ -5,7 +5,7 @@
 //! vector ground truth (symmetric Hausdorff, px) and median time of 5 runs.
 //!
 //! ```text
-//! cargo run --release --example compare_potrace [-- RUNS]
+//! cargo run --release -p flourish-tools --bin compare_potrace [-- RUNS]
 //! ```
 //!
 //! The measurement code is shared with `tests/potrace.rs`

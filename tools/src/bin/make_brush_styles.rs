@@ -28,7 +28,7 @@
 //! Regenerate with:
 //!
 //! ```text
-//! cargo run --release --example make_brush_styles -- styles/
+//! cargo run --release -p flourish-tools --bin make_brush_styles -- styles/
 //! ```
 //!
 //! An optional second argument (`vine`, `scroll` or `doodle`) writes just

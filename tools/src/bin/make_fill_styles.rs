@@ -1,8 +1,9 @@
 //! Draws the tiles of the two shipped fill styles (`knot`, `scales`) and
 //! the fill sample sketches, deterministically.
 //!
-//! Run: `cargo run --example make_fill_styles` (writes `styles/knot`,
-//! `styles/scales` and `samples/fill/` under the crate root).
+//! Run: `cargo run -p flourish-tools --bin make_fill_styles` (writes
+//! `styles/knot`, `styles/scales` and `samples/fill/` under the crate
+//! root).
 //!
 //! Both tiles are seamless: everything is drawn for the neighbouring
 //! copies too, and the canvas cuts it at the tile's edge.

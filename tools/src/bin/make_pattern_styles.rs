@@ -1,8 +1,8 @@
 //! Draws the example SVGs of the four shipped pattern styles and the
 //! pattern sample sketches, deterministically (hashed jitter, no clock).
 //!
-//! Run: `cargo run --example make_pattern_styles` (writes `styles/` and
-//! `samples/pattern/` under the crate root).
+//! Run: `cargo run -p flourish-tools --bin make_pattern_styles` (writes
+//! `styles/` and `samples/pattern/` under the crate root).
 
 use flourish_tools::unit;
 use std::f64::consts::PI;

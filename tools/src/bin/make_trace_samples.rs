@@ -28,7 +28,7 @@
 //! Rerun with:
 //!
 //! ```text
-//! cargo run --release --example make_trace_samples -- samples/trace
+//! cargo run --release -p flourish-tools --bin make_trace_samples -- samples/trace
 //! ```
 
 use std::f64::consts::{PI, TAU};
