@@ -92,7 +92,7 @@ pub fn brush<'a>(
     styles: impl Into<Styles<'a>>,
     opts: &BrushOptions,
 ) -> Result<Output> {
-    brush::run(styles.into().default_style().brush()?, sketch, opts)
+    brush::run(styles.into().default_style().brush()?, sketch, opts).map(finish)
 }
 
 /// Fills every filled shape of `sketch` with an art pattern synthesized
@@ -127,11 +127,11 @@ pub fn fill<'a>(
         },
         opts,
     )?;
-    Ok(Output {
+    Ok(finish(Output {
         document: out.to_document(),
         warnings: Vec::new(),
         notes: out.notes,
-    })
+    }))
 }
 
 /// Arranges the hand-drawn elements of a pattern style along every
@@ -159,7 +159,7 @@ pub fn pattern<'a>(
 ) -> Result<Output> {
     let styles = styles.into();
     let out = pattern::synthesize_sketch(sketch, |q| Ok(styles.of(q)?.pattern()?.clone()), opts)?;
-    Ok(Output::new(out.to_document()))
+    Ok(finish(Output::new(out.to_document())))
 }
 
 /// A picture to trace: a raster (PNG, JPEG, BMP, GIF, TIFF, WebP) or an
@@ -197,7 +197,16 @@ impl Image {
 /// # }
 /// ```
 pub fn trace(image: &Image, opts: &TraceOptions) -> Result<Output> {
-    trace::trace(&image.picture, opts)
+    trace::trace(&image.picture, opts).map(finish)
+}
+
+/// A mode's output made safe to render: past [`svg_out::MAX_ELEMENTS`]
+/// paths, the shapes of a group painted alike are merged, with a note.
+fn finish(mut out: Output) -> Output {
+    if let Some(note) = out.document.merge_past_limit() {
+        out.notes.push(note);
+    }
+    out
 }
 
 /// Analyses a brush style for `flourish style check`: a report per

@@ -87,7 +87,12 @@ impl Style {
     /// Loads the style in `dir`, known by `name` in notes.
     fn load_named_as(name: &str, dir: &Path, opts: &StyleOptions) -> Result<Style> {
         opts.validate()?;
+        let toml_path = dir.join(STYLE_FILE);
+        if !crate::io::is_regular_file(&toml_path) {
+            return Err(Error::invalid("not a regular file").in_file(toml_path));
+        }
         let manifest = toml::load(dir)?;
+        check_files(dir, &manifest)?;
         let kind = manifest.kind;
         if let Some(want) = opts.kind {
             wrong_kind(dir, kind, want)?;
@@ -170,6 +175,34 @@ impl Style {
             Ok(()) => Error::invalid("the style is of the right kind"),
         }
     }
+}
+
+/// Checks that every exemplar `toml` lists is a regular file inside the
+/// style folder `dir` once symbolic links are followed: a link may not
+/// lead a style out of its folder (to `/etc/passwd`, say), and a FIFO or a
+/// device would block or never end when read. Errors name the key.
+fn check_files(dir: &Path, toml: &toml::StyleToml) -> Result<()> {
+    let toml_path = dir.join(STYLE_FILE);
+    let bad = |i: usize, why: String| {
+        Err(Error::invalid(format!("exemplar[{i}].file: {why}")).in_file(&toml_path))
+    };
+    let home = std::fs::canonicalize(dir).map_err(|e| Error::io(dir, e))?;
+    for (i, ex) in toml.exemplar.iter().enumerate() {
+        let path = dir.join(&ex.file);
+        let Ok(real) = std::fs::canonicalize(&path) else {
+            return bad(i, format!("{} does not exist", ex.file.display()));
+        };
+        if !real.starts_with(&home) {
+            return bad(
+                i,
+                format!("{} leads out of the style folder", ex.file.display()),
+            );
+        }
+        if !crate::io::is_regular_file(&real) {
+            return bad(i, format!("{} is not a regular file", ex.file.display()));
+        }
+    }
+    Ok(())
 }
 
 /// The error for a style of kind `is` where `want` is needed, naming its
@@ -382,6 +415,42 @@ mod tests {
             e.starts_with("q-2: data-style \"no-such-style\": style not found"),
             "{e}"
         );
+    }
+
+    /// A style's files are regular files inside its folder: a symbolic link
+    /// out of it, a FIFO and a missing exemplar are refused before anything
+    /// is read, naming the key.
+    #[cfg(unix)]
+    #[test]
+    fn style_files_stay_in_their_folder() {
+        let tmp = tempfile::tempdir().expect("temp dir");
+        let dir = tmp.path().join("s");
+        std::fs::create_dir_all(&dir).expect("folder");
+        let write_toml = |file: &str| {
+            std::fs::write(
+                dir.join(STYLE_FILE),
+                format!("kind = \"pattern\"\nscale = 2.0\n[[exemplar]]\nfile = \"{file}\"\n"),
+            )
+            .expect("writes");
+        };
+        let refused = |file: &str, why: &str| {
+            write_toml(file);
+            let e = Style::load(&dir, &StyleOptions::default())
+                .expect_err(file)
+                .to_string();
+            assert!(e.contains("exemplar[0].file") && e.contains(why), "{e}");
+        };
+        std::os::unix::fs::symlink("/etc/passwd", dir.join("passwd.svg")).expect("link");
+        refused("passwd.svg", "leads out of the style folder");
+        let fifo = dir.join("fifo.svg");
+        let made = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .is_ok_and(|s| s.success());
+        if made {
+            refused("fifo.svg", "not a regular file");
+        }
+        refused("missing.svg", "does not exist");
     }
 
     /// A name is found in the first folder that holds it; one that no

@@ -207,6 +207,19 @@ struct DiffArgs {
     out: Option<PathBuf>,
 }
 
+/// The argument parser's message on one line: its lines up to the usage
+/// summary, without tips, joined.
+fn one_line(e: &clap::Error) -> String {
+    let text = e.render().to_string();
+    let words: Vec<&str> = text
+        .lines()
+        .take_while(|l| !l.starts_with("Usage:"))
+        .filter(|l| !l.trim_start().starts_with("tip:"))
+        .flat_map(str::split_whitespace)
+        .collect();
+    words.join(" ").trim_start_matches("error: ").to_string()
+}
+
 /// A failure and the exit status it maps to.
 enum Failure {
     Usage(String),
@@ -230,10 +243,14 @@ impl From<Error> for Failure {
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(c) => c,
+        Err(e) if e.use_stderr() => {
+            eprintln!("flourish: {} (see flourish --help)", one_line(&e));
+            return ExitCode::from(2);
+        }
         Err(e) => {
-            let code = if e.use_stderr() { 2 } else { 0 };
+            // --help and --version.
             let _ = e.print();
-            return ExitCode::from(code);
+            return ExitCode::SUCCESS;
         }
     };
     match run(cli) {

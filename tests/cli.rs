@@ -957,6 +957,81 @@ fn unknown_flag_is_a_usage_error() {
     assert_eq!(code(&o), Some(2), "no subcommand: stderr {}", stderr(&o));
 }
 
+/// Every usage error is one line on stderr, the argument parser's too.
+#[test]
+fn usage_errors_are_one_line() {
+    let t = tempdir();
+    let a = t.path().join("a.png");
+    write_disc_png(&a, 16);
+    for args in [
+        vec!["trace", s(&a), "--frobnicate"],
+        vec!["trace"],
+        vec!["frobnicate"],
+        vec!["trace", s(&a), "--tolerance", "lots"],
+        vec![],
+    ] {
+        let o = flourish(&args);
+        assert_eq!(code(&o), Some(2), "{args:?}: {}", stderr(&o));
+        assert_eq!(stderr(&o).lines().count(), 1, "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).starts_with("flourish: "), "{}", stderr(&o));
+    }
+}
+
+/// A result for standard output with standard output closed, or read by
+/// no one, is a failure, exit 1, not a silent success; `> /dev/null` is a
+/// success.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_closed_standard_output_fails_the_run() {
+    let t = tempdir();
+    let a = t.path().join("a.png");
+    write_disc_png(&a, 16);
+    let run = |redirect: &str| {
+        Command::new("bash")
+            .args([
+                "-c",
+                &format!("set -o pipefail; \"$0\" trace \"$1\" -o - {redirect}"),
+                BIN,
+                s(&a),
+            ])
+            .stdin(Stdio::null())
+            .output()
+            .expect("run bash")
+    };
+    for redirect in [">&-", "| (exec 0<&-; sleep 1)"] {
+        let o = run(redirect);
+        assert_eq!(code(&o), Some(1), "{redirect}: stderr: {}", stderr(&o));
+        assert_eq!(stderr(&o).lines().count(), 1, "{}", stderr(&o));
+        assert!(stderr(&o).contains("<stdout>"), "{}", stderr(&o));
+    }
+    let o = run("> /dev/null");
+    assert_eq!(code(&o), Some(0), "stderr: {}", stderr(&o));
+}
+
+/// An SVG whose entities would expand quadratically (a 100 kB entity
+/// referenced 20 000 times: 2 GB from 160 kB) is refused at once, in one
+/// line, without the memory it would take.
+#[test]
+fn entities_that_would_fill_memory_are_refused() {
+    let t = tempdir();
+    let svg = t.path().join("lol.svg");
+    let text = format!(
+        r#"<?xml version="1.0"?><!DOCTYPE svg [<!ENTITY a "{}">]><svg xmlns="http://www.w3.org/2000/svg" width="10" height="10"><text>{}</text></svg>"#,
+        "x".repeat(100_000),
+        "&a;".repeat(20_000)
+    );
+    std::fs::write(&svg, text).expect("write");
+    let out = t.path().join("out.svg");
+    for cmd in [
+        vec!["trace", s(&svg), "-o", s(&out)],
+        vec!["pattern", s(&svg), "-o", s(&out)],
+    ] {
+        let o = flourish_capped(t.path(), &cmd, 1024);
+        assert_failure(&o, &svg, &["entities expand"]);
+        assert!(!out.exists());
+    }
+}
+
 #[test]
 fn help_and_version_succeed() {
     let o = flourish(&["--help"]);
