@@ -52,6 +52,28 @@ pub fn read_file(path: &Path) -> Result<Vec<u8>> {
     read_capped(path, MAX_FILE_BYTES)
 }
 
+/// Reads an input of the command line: `-` is standard input, read to its
+/// end (refused past [`MAX_FILE_BYTES`]); anything else [`read_file`].
+pub fn read_input(path: &Path) -> Result<Vec<u8>> {
+    use std::io::Read as _;
+    if path.as_os_str() != "-" {
+        return read_file(path);
+    }
+    let mut out = Vec::new();
+    std::io::stdin()
+        .lock()
+        .take(MAX_FILE_BYTES + 1)
+        .read_to_end(&mut out)
+        .map_err(|e| Error::io("<stdin>", e))?;
+    if out.len() as u64 > MAX_FILE_BYTES {
+        return Err(
+            Error::invalid(format!("more than the limit of {MAX_FILE_BYTES} bytes"))
+                .in_file("<stdin>"),
+        );
+    }
+    Ok(out)
+}
+
 /// Reads `path` to its end or to `cap` + 1 bytes, whichever comes first;
 /// more than `cap` bytes is an error.
 fn read_capped(path: &Path, cap: u64) -> Result<Vec<u8>> {

@@ -277,9 +277,52 @@ impl Library {
         }
     }
 
-    /// The styles shipped with flourish (the crate's `styles/` folder).
+    /// The styles shipped with flourish (they travel inside the binary).
     pub fn shipped() -> Library {
         Library::new([shipped_dir()])
+    }
+
+    /// The command line's search path: the folders `extra` (`--styles
+    /// DIR`), then those of `$FLOURISH_STYLES` (separated like `PATH`),
+    /// then the shipped styles.
+    pub fn search<P: Into<PathBuf>>(extra: impl IntoIterator<Item = P>) -> Library {
+        let mut dirs: Vec<PathBuf> = extra.into_iter().map(Into::into).collect();
+        if let Some(env) = std::env::var_os(STYLES_ENV) {
+            dirs.extend(std::env::split_paths(&env).filter(|d| !d.as_os_str().is_empty()));
+        }
+        dirs.push(shipped_dir());
+        Library { dirs }
+    }
+
+    /// Every style the library's folders hold, by name (a name found in an
+    /// earlier folder hides the same name in later ones), sorted by name.
+    pub fn styles(&self) -> Vec<StyleEntry> {
+        let mut seen: BTreeMap<String, StyleEntry> = BTreeMap::new();
+        for d in &self.dirs {
+            let Ok(entries) = std::fs::read_dir(d) else {
+                continue;
+            };
+            for e in entries.filter_map(|e| e.ok()) {
+                let dir = e.path();
+                let name = e.file_name().to_string_lossy().into_owned();
+                if seen.contains_key(&name) || !dir.join(STYLE_FILE).is_file() {
+                    continue;
+                }
+                let summary = std::fs::read_to_string(dir.join(STYLE_FILE))
+                    .ok()
+                    .and_then(|t| ::toml::from_str::<Summary>(&t).ok());
+                seen.insert(
+                    name.clone(),
+                    StyleEntry {
+                        name,
+                        kind: summary.as_ref().map(|s| s.kind),
+                        exemplars: summary.map_or(0, |s| s.exemplar.len()),
+                        dir,
+                    },
+                );
+            }
+        }
+        seen.into_values().collect()
     }
 
     /// The folder of `style`: `style` itself when it is a folder holding
@@ -302,7 +345,13 @@ impl Library {
             [a, b] => format!("neither {a} nor {b} exists"),
             _ => format!("none of {} exists", tried.join(", ")),
         };
-        Err(Error::invalid(format!("style not found: {tried}")).in_file(direct))
+        let close = close_names(style, &self.styles());
+        let hint = if close.is_empty() {
+            String::new()
+        } else {
+            format!(" (did you mean {}?)", close.join(", "))
+        };
+        Err(Error::invalid(format!("style not found: {tried}{hint}")).in_file(direct))
     }
 
     /// Finds `style` ([`Library::find`]) and loads it under that name.
@@ -372,9 +421,116 @@ impl Library {
     }
 }
 
-/// The crate's own `styles/` folder.
+/// One style of a library, as `flourish style list` shows it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StyleEntry {
+    /// Its folder's name, the name it is loaded by.
+    pub name: String,
+    /// Its folder.
+    pub dir: PathBuf,
+    /// What it is for (`None` when its `style.toml` does not say).
+    pub kind: Option<StyleKind>,
+    /// How many `[[exemplar]]` tables it lists.
+    pub exemplars: usize,
+}
+
+/// What `style list` reads of a `style.toml`, without checking the rest.
+#[derive(serde::Deserialize)]
+struct Summary {
+    kind: StyleKind,
+    #[serde(default)]
+    exemplar: Vec<::toml::Value>,
+}
+
+/// The names of `styles` close to `name`: at most two edits away (or
+/// three for long names), or holding it, best first.
+fn close_names(name: &str, styles: &[StyleEntry]) -> Vec<String> {
+    let wanted = name.rsplit('/').next().unwrap_or(name).to_lowercase();
+    let limit = if wanted.chars().count() > 8 { 3 } else { 2 };
+    let mut close: Vec<(usize, String)> = styles
+        .iter()
+        .filter_map(|s| {
+            let d = edits(&wanted, &s.name.to_lowercase());
+            let holds = !wanted.is_empty() && s.name.to_lowercase().contains(&wanted);
+            (d <= limit || holds).then(|| (d, s.name.clone()))
+        })
+        .collect();
+    close.sort();
+    close.into_iter().take(3).map(|(_, n)| n).collect()
+}
+
+/// The Levenshtein distance between `a` and `b`, in characters.
+fn edits(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut prev = row[0];
+        row[0] = i + 1;
+        for (j, &cb) in b.iter().enumerate() {
+            let next = (prev + usize::from(ca != cb))
+                .min(row[j] + 1)
+                .min(row[j + 1] + 1);
+            prev = row[j + 1];
+            row[j + 1] = next;
+        }
+    }
+    row[b.len()]
+}
+
+include!(concat!(env!("OUT_DIR"), "/shipped_styles.rs"));
+
+/// Environment variable holding more style folders, separated like `PATH`.
+pub const STYLES_ENV: &str = "FLOURISH_STYLES";
+
+/// The folder holding the shipped styles, which travel inside the binary:
+/// unpacked once into the cache folder (a folder per content, so an older
+/// or newer binary's stay as they were; written whole, then renamed into
+/// place), or into the temporary folder when there is no cache folder.
 pub(crate) fn shipped_dir() -> PathBuf {
-    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/styles"))
+    use std::sync::OnceLock;
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let base = directories::ProjectDirs::from("", "", "flourish")
+            .map(|p| p.cache_dir().to_path_buf())
+            .unwrap_or_else(|| std::env::temp_dir().join("flourish"));
+        let dir = base.join(format!("shipped-{SHIPPED_HASH:016x}"));
+        if dir.is_dir() || unpack(&base, &dir).is_ok() {
+            dir
+        } else {
+            // Unwritable cache: a private copy in the temporary folder.
+            let tmp = std::env::temp_dir().join(format!(
+                "flourish-shipped-{SHIPPED_HASH:016x}-{}",
+                std::process::id()
+            ));
+            let _ = unpack(&std::env::temp_dir(), &tmp);
+            tmp
+        }
+    })
+    .clone()
+}
+
+/// Writes the shipped styles into a fresh folder in `base` and renames it
+/// to `dir` (another process doing the same at once is harmless).
+fn unpack(base: &Path, dir: &Path) -> std::io::Result<()> {
+    std::fs::create_dir_all(base)?;
+    let tmp = tempfile::Builder::new()
+        .prefix(".shipped-")
+        .tempdir_in(base)?;
+    for (rel, bytes) in SHIPPED {
+        let path = tmp.path().join(rel);
+        if let Some(parent) = path.parent() {
+            std::fs::create_dir_all(parent)?;
+        }
+        std::fs::write(path, bytes)?;
+    }
+    match std::fs::rename(tmp.path(), dir) {
+        Ok(()) => {
+            let _ = tmp.keep();
+            Ok(())
+        }
+        Err(_) if dir.is_dir() => Ok(()),
+        Err(e) => Err(e),
+    }
 }
 
 #[cfg(test)]

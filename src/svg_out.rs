@@ -149,6 +149,27 @@ pub struct Document {
 pub const MAX_ELEMENTS: usize = 200_000;
 
 impl Document {
+    /// The document with its drawing scaled by `f` and its view box set
+    /// to `view_box`: every path and stroke width, with the decimals
+    /// that keep the same precision.
+    pub(crate) fn rescaled(mut self, f: f64, view_box: Rect) -> Document {
+        let to = kurbo::Affine::scale(f);
+        for g in &mut self.groups {
+            for s in &mut g.shapes {
+                s.path.apply_affine(to);
+                if let Some(st) = &mut s.stroke {
+                    st.width *= f;
+                }
+            }
+        }
+        self.view_box = view_box;
+        let more = (-f.log10()).ceil();
+        if more.is_finite() && more > 0.0 {
+            self.decimals = (self.decimals + more as u32).min(15);
+        }
+        self
+    }
+
     /// Merges the shapes of each group that share fill, fill rule, stroke
     /// and opacity into one path each, when the document holds more than
     /// [`MAX_ELEMENTS`] shapes; returns the note saying so, if it did. The

@@ -95,6 +95,42 @@ impl Sketch {
     pub fn from_svg(bytes: &[u8]) -> Result<Sketch> {
         parse(bytes)
     }
+
+    /// CSS pixels per user unit: how large the sketch's units are drawn
+    /// (3.78 for a sketch in millimetres, 1.33 in points, 1 in px). The
+    /// mean of the two axes' scales when its aspect is not kept.
+    pub fn px_per_unit(&self) -> f64 {
+        let (vw, vh) = (self.view_box.width(), self.view_box.height());
+        let k = ((self.width / vw) * (self.height / vh)).sqrt();
+        if k.is_finite() && k > 0.0 {
+            k
+        } else {
+            1.0
+        }
+    }
+
+    /// The sketch with its user units scaled by `k`: every query's
+    /// geometry and width, and the view box; the drawn size stays.
+    pub(crate) fn scaled(&self, k: f64) -> Sketch {
+        let to = kurbo::Affine::scale(k);
+        let mut out = self.clone();
+        out.view_box = Rect::new(
+            k * self.view_box.x0,
+            k * self.view_box.y0,
+            k * self.view_box.x1,
+            k * self.view_box.y1,
+        );
+        for q in &mut out.queries {
+            match &mut q.kind {
+                QueryKind::Path { spine, width } => {
+                    spine.apply_affine(to);
+                    *width *= k;
+                }
+                QueryKind::Region { outline, .. } => outline.apply_affine(to),
+            }
+        }
+        out
+    }
 }
 
 /// Reads and parses a sketch SVG file; errors name it.
