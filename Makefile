@@ -17,6 +17,9 @@ deps:
 	  { echo "make: potrace could not be installed: install the Debian package potrace" >&2; exit 1; }; \
 	fi
 
+# Brush sketches (the refinement sketch is drawn over s-curve.svg, not brushed).
+BRUSH_SKETCHES = $(filter-out %-refine.svg,$(wildcard samples/brush/*.svg))
+
 # The main job on the shipped samples: traces and patterns, with previews, into out/.
 demo:
 	$(CARGO) build --release
@@ -39,9 +42,12 @@ demo:
 	done
 	for style in vine scroll doodle; do \
 	  mkdir -p $(OUT)/brush/$$style $(OUT)/brush/$$style-art-brush; \
-	  $(BIN) brush --style $$style samples/brush/*.svg --out-dir $(OUT)/brush/$$style --preview $(OUT)/brush/$$style || exit 1; \
-	  $(BIN) brush --art-brush --style $$style samples/brush/*.svg --out-dir $(OUT)/brush/$$style-art-brush --preview $(OUT)/brush/$$style-art-brush || exit 1; \
+	  $(BIN) brush --style $$style $(BRUSH_SKETCHES) --out-dir $(OUT)/brush/$$style --preview $(OUT)/brush/$$style || exit 1; \
+	  $(BIN) brush --art-brush --style $$style $(BRUSH_SKETCHES) --out-dir $(OUT)/brush/$$style-art-brush --preview $(OUT)/brush/$$style-art-brush || exit 1; \
 	done
+	$(BIN) brush --style vine samples/brush/s-curve.svg --refine samples/brush/s-curve-refine.svg -o $(OUT)/brush/s-curve-refined.svg --preview $(OUT)/brush/s-curve-refined.png
+	mkdir -p $(OUT)/decorate
+	$(BIN) decorate --strokes vine --regions knot samples/decorate/card.svg -o $(OUT)/decorate/card.svg --preview $(OUT)/decorate/card.png
 	@echo "demo outputs (SVG + preview PNG) are in $(OUT)/"
 
 # The whole test suite, built once with the test profile (optimized: see

@@ -11,6 +11,7 @@
 //! | art patterns inside closed shapes (level sets) | [`Sketch`] | fill | [`fill()`] |
 //! | hand-drawn elements along paths and in shapes | [`Sketch`] | pattern | [`pattern()`] |
 //! | bitmaps and SVGs to Bézier outlines | [`Image`] | — | [`trace()`] |
+//! | a whole mixed sketch, the rest kept | [`Sketch`] | any, per shape | [`decorate()`] |
 //!
 //! Options carry values with documented defaults; each has a `validate()`
 //! that checks every range. Errors are one [`Error`] enum; functions that
@@ -66,6 +67,7 @@ pub use read::ImageOptions;
 pub use svg_out::{Color, Document, FillRule, Group, LineCap, LineJoin, Output, Shape, Stroke};
 pub use trace::TraceOptions;
 
+use std::collections::BTreeMap;
 use std::path::Path;
 
 /// Grows ornament of a brush style along every open stroked path of
@@ -181,6 +183,206 @@ pub fn pattern<'a>(
     Ok(finish(out))
 }
 
+/// The styles of a whole-sketch decoration ([`decorate()`]): a shape's
+/// `data-style` names its style in `named`; other stroked paths take
+/// `strokes` and other filled shapes `regions`. A shape with no style is
+/// kept as drawn.
+#[derive(Clone, Copy, Debug)]
+pub struct Decoration<'a> {
+    /// Style of stroked paths without `data-style`: brush or pattern.
+    pub strokes: Option<&'a Style>,
+    /// Style of filled shapes without `data-style`: fill or pattern.
+    pub regions: Option<&'a Style>,
+    /// The styles shapes name, by name ([`Library::load_every_named`]).
+    pub named: &'a BTreeMap<String, Style>,
+}
+
+impl Decoration<'_> {
+    /// Checks that `strokes` is a brush or pattern style and `regions` a
+    /// fill or pattern style.
+    pub fn validate(&self) -> Result<()> {
+        for (name, style, wrong, takes) in [
+            (
+                "strokes",
+                self.strokes,
+                StyleKind::Fill,
+                "a brush or pattern style",
+            ),
+            (
+                "regions",
+                self.regions,
+                StyleKind::Brush,
+                "a fill or pattern style",
+            ),
+        ] {
+            if let Some(s) = style.filter(|s| s.kind() == wrong) {
+                return Err(Error::Option {
+                    name,
+                    reason: format!(
+                        "{} is a {} style; {name} take {takes}",
+                        s.name(),
+                        wrong.name()
+                    ),
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Options of the modes a decoration runs, each with its own defaults.
+#[derive(Clone, Debug, Default)]
+pub struct DecorateOptions {
+    /// For shapes decorated with a brush style.
+    pub brush: BrushOptions,
+    /// For shapes decorated with a fill style.
+    pub fill: FillOptions,
+    /// For shapes decorated with a pattern style.
+    pub pattern: PatternOptions,
+}
+
+impl DecorateOptions {
+    /// Checks every mode's options.
+    pub fn validate(&self) -> Result<()> {
+        self.brush.validate()?;
+        self.fill.validate()?;
+        self.pattern.validate()
+    }
+}
+
+/// Decorates a whole sketch in one go: each stroked path and filled shape
+/// with its style (by `data-style`, else the defaults of `styles`), by the
+/// mode of that style's kind, and the ornament laid over the sketch in
+/// place of the shapes it decorates, so text, images and undecorated
+/// shapes stay where they are in drawing order. Open paths that no style
+/// decorates still comb the direction of fill patterns around them.
+/// A brush style on a filled shape, or a fill style on a stroked path,
+/// leaves the shape as drawn, with a warning.
+///
+/// ```no_run
+/// # fn main() -> flourish::Result<()> {
+/// use flourish::{Decoration, DecorateOptions, Library, Sketch, StyleOptions};
+///
+/// let lib = Library::shipped();
+/// let vine = lib.load("vine", &StyleOptions::default())?;
+/// let knot = lib.load("knot", &StyleOptions::default())?;
+/// let sketch = Sketch::from_svg(&std::fs::read("card.svg").unwrap())?;
+/// let named = lib.load_every_named(&sketch, &StyleOptions::default())?;
+/// let styles = Decoration { strokes: Some(&vine), regions: Some(&knot), named: &named };
+/// let out = flourish::decorate(&sketch, styles, &DecorateOptions::default())?;
+/// std::fs::write("card-decorated.svg", out.to_svg()).unwrap();
+/// # Ok(())
+/// # }
+/// ```
+pub fn decorate(sketch: &Sketch, styles: Decoration, opts: &DecorateOptions) -> Result<Output> {
+    opts.validate()?;
+    styles.validate()?;
+    let mut warnings = Vec::new();
+    // The queries of each style, in the order styles first appear.
+    let mut runs: Vec<(&Style, Vec<usize>)> = Vec::new();
+    for (i, q) in sketch.queries.iter().enumerate() {
+        let style = match &q.style {
+            Some(name) => Some(styles.named.get(name).ok_or_else(|| {
+                Error::invalid(format!("data-style \"{name}\" was not loaded")).in_part(&q.id)
+            })?),
+            None => match q.kind {
+                QueryKind::Path { .. } => styles.strokes,
+                QueryKind::Region { .. } => styles.regions,
+            },
+        };
+        let Some(style) = style else { continue };
+        let fits = match (style.kind(), &q.kind) {
+            (StyleKind::Brush, QueryKind::Region { .. }) => Some("strokes"),
+            (StyleKind::Fill, QueryKind::Path { .. }) => Some("filled shapes"),
+            _ => None,
+        };
+        if let Some(what) = fits {
+            warnings.push(format!(
+                "{}: style {} decorates {what} only; the shape is kept as drawn",
+                q.id,
+                style.name()
+            ));
+            continue;
+        }
+        match runs.iter_mut().find(|(s, _)| std::ptr::eq(*s, style)) {
+            Some((_, qs)) => qs.push(i),
+            None => runs.push((style, vec![i])),
+        }
+    }
+    let decorated: Vec<bool> = {
+        let mut d = vec![false; sketch.queries.len()];
+        for (_, qs) in &runs {
+            for &i in qs {
+                d[i] = true;
+            }
+        }
+        d
+    };
+    let mut notes = Vec::new();
+    let mut groups: BTreeMap<String, std::collections::VecDeque<Group>> = BTreeMap::new();
+    let mut decimals = 0;
+    for (style, qs) in &runs {
+        let mut part = sketch.clone();
+        part.notes.clear();
+        part.warnings.clear();
+        part.text_left_out = None;
+        part.queries = sketch
+            .queries
+            .iter()
+            .enumerate()
+            .filter(|(i, q)| {
+                qs.contains(i)
+                    || style.kind() == StyleKind::Fill
+                        && !decorated[*i]
+                        && matches!(q.kind, QueryKind::Path { .. })
+            })
+            .map(|(_, q)| Query {
+                style: None,
+                ..q.clone()
+            })
+            .collect();
+        let out = match style.kind() {
+            StyleKind::Brush => brush(&part, *style, &opts.brush)?,
+            StyleKind::Fill => fill(&part, *style, &opts.fill)?,
+            StyleKind::Pattern => pattern(&part, *style, &opts.pattern)?,
+        };
+        warnings.extend(out.warnings);
+        notes.extend(out.notes);
+        decimals = decimals.max(out.document.decimals);
+        for g in out.document.groups {
+            groups.entry(g.id.clone()).or_default().push_back(g);
+        }
+    }
+    let mut document = Document::new(sketch.width, sketch.height, decimals.max(2));
+    document.view_box = sketch.view_box;
+    document.groups = sketch
+        .queries
+        .iter()
+        .filter_map(|q| groups.get_mut(&q.id)?.pop_front())
+        .collect();
+    let out = Output {
+        document,
+        warnings,
+        notes,
+    };
+    Ok(out.over(sketch))
+}
+
+impl Output {
+    /// This output laid over the sketch it was made from: each group in
+    /// place of the shape it decorates (its query's element), and every
+    /// other element of the sketch kept in drawing order. A sketch made in
+    /// code has no text to keep: the output is unchanged.
+    pub fn over(mut self, sketch: &Sketch) -> Output {
+        if sketch.backdrop.is_some() {
+            self.warnings
+                .retain(|w| Some(w.as_str()) != sketch.text_left_out);
+        }
+        self.document.backdrop = sketch.backdrop.clone();
+        self
+    }
+}
+
 /// A picture to trace: a raster (PNG, JPEG, BMP, GIF, TIFF, WebP) or an
 /// SVG, read as layers of ink.
 #[derive(Clone, Debug)]
@@ -225,11 +427,14 @@ pub fn trace(image: &Image, opts: &TraceOptions) -> Result<Output> {
 /// sketch's units.
 fn in_px(sketch: &Sketch, run: impl FnOnce(&Sketch) -> Result<Output>) -> Result<Output> {
     let k = sketch.px_per_unit();
-    if (k - 1.0).abs() <= 1e-9 {
-        return run(sketch);
-    }
-    let mut out = run(&sketch.scaled(k))?;
-    out.document = out.document.rescaled(1.0 / k, sketch.view_box);
+    let mut out = if (k - 1.0).abs() <= 1e-9 {
+        run(sketch)?
+    } else {
+        let mut out = run(&sketch.scaled(k))?;
+        out.document = out.document.rescaled(1.0 / k, sketch.view_box);
+        out
+    };
+    out.warnings.extend(sketch.text_left_out.map(String::from));
     Ok(out)
 }
 

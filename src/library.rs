@@ -371,15 +371,35 @@ impl Library {
         kind: StyleKind,
         opts: &StyleOptions,
     ) -> Result<BTreeMap<String, Style>> {
+        self.load_named_where(sketch, opts, |q| match (kind, &q.kind) {
+            (StyleKind::Brush, _) => false,
+            (StyleKind::Fill, QueryKind::Region { .. }) => true,
+            (StyleKind::Fill, QueryKind::Path { .. }) => false,
+            (StyleKind::Pattern, _) => true,
+        })
+    }
+
+    /// Every style the shapes of `sketch` name with `data-style="NAME"`,
+    /// of any kind, by name: the named styles of [`crate::decorate()`].
+    /// Names are looked up as in [`Library::load_named`].
+    pub fn load_every_named(
+        &self,
+        sketch: &Sketch,
+        opts: &StyleOptions,
+    ) -> Result<BTreeMap<String, Style>> {
+        self.load_named_where(sketch, opts, |_| true)
+    }
+
+    /// The styles named by the queries `decorated` accepts.
+    fn load_named_where(
+        &self,
+        sketch: &Sketch,
+        opts: &StyleOptions,
+        decorated: impl Fn(&Query) -> bool,
+    ) -> Result<BTreeMap<String, Style>> {
         let mut named = BTreeMap::new();
         for q in &sketch.queries {
-            let decorated = match (kind, &q.kind) {
-                (StyleKind::Brush, _) => false,
-                (StyleKind::Fill, QueryKind::Region { .. }) => true,
-                (StyleKind::Fill, QueryKind::Path { .. }) => false,
-                (StyleKind::Pattern, _) => true,
-            };
-            let Some(name) = q.style.as_ref().filter(|_| decorated) else {
+            let Some(name) = q.style.as_ref().filter(|_| decorated(q)) else {
                 continue;
             };
             if !named.contains_key(name) {

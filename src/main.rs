@@ -3,8 +3,9 @@
 
 use clap::{Args, Parser, Subcommand};
 use flourish::{
-    io, BrushOptions, Error, FillOptions, Image, ImageOptions, Library, Output, PatternOptions,
-    Refinement, Sketch, StyleKind, StyleOptions, Styles, TraceOptions,
+    io, BrushOptions, DecorateOptions, Decoration, Error, FillOptions, Image, ImageOptions,
+    Library, Output, PatternOptions, Refinement, Sketch, StyleKind, StyleOptions, Styles,
+    TraceOptions,
 };
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
@@ -41,6 +42,8 @@ enum Command {
     Fill(FillArgs),
     /// Grow structured ornament of a brush style along open paths (DecoBrush).
     Brush(BrushArgs),
+    /// Decorate a whole sketch: strokes and shapes each by its style, everything else kept.
+    Decorate(DecorateArgs),
     /// Compare two SVGs by rendering: exit 0 alike, 1 different beyond --tolerance, 2 trouble.
     Diff(DiffArgs),
     /// Style libraries: analyse, report and draw diagnostics.
@@ -121,6 +124,9 @@ struct FillArgs {
     styles: Option<PathBuf>,
     #[command(flatten)]
     out: Outputs,
+    /// Keep the sketch: the ornament replaces the shapes it decorates, the rest stays.
+    #[arg(long)]
+    keep_sketch: bool,
     /// An SVG of open stroked paths that comb the pattern's direction in every region.
     #[arg(long, value_name = "D.svg")]
     direction: Option<PathBuf>,
@@ -145,6 +151,9 @@ struct BrushArgs {
     cache: Option<PathBuf>,
     #[command(flatten)]
     out: Outputs,
+    /// Keep the sketch: the ornament replaces the shapes it decorates, the rest stays.
+    #[arg(long)]
+    keep_sketch: bool,
     /// Write N alternatives OUT-1.svg … OUT-N.svg, or NAME-v1.svg … NAME-vN.svg
     /// with --out-dir (seeds seed … seed+N−1).
     #[arg(long, default_value_t = 1, value_name = "N")]
@@ -173,9 +182,33 @@ struct PatternArgs {
     styles: Option<PathBuf>,
     #[command(flatten)]
     out: Outputs,
+    /// Keep the sketch: the ornament replaces the shapes it decorates, the rest stays.
+    #[arg(long)]
+    keep_sketch: bool,
     /// How much repeated elements vary in place and turn (Barla et al. §3.3), 0..1.
     #[arg(long, alias = "variation", default_value_t = 0.0, value_name = "0..1")]
     jitter: f64,
+}
+
+#[derive(Args)]
+struct DecorateArgs {
+    /// Sketch SVGs: a shape's data-style names its style; others take --strokes or --regions.
+    #[arg(required = true, value_name = "SKETCH.svg")]
+    sketches: Vec<PathBuf>,
+    /// Style of stroked paths without data-style: a brush or pattern style.
+    #[arg(long, value_name = "STYLE")]
+    strokes: Option<String>,
+    /// Style of filled shapes without data-style: a fill or pattern style.
+    #[arg(long, value_name = "STYLE")]
+    regions: Option<String>,
+    /// Folder of named styles searched first.
+    #[arg(long, value_name = "DIR")]
+    styles: Option<PathBuf>,
+    /// Brush analysis cache folder.
+    #[arg(long, value_name = "DIR")]
+    cache: Option<PathBuf>,
+    #[command(flatten)]
+    out: Outputs,
 }
 
 #[derive(Args)]
@@ -306,6 +339,7 @@ fn run(cli: Cli) -> Result<(), Failure> {
         Command::Pattern(args) => run_pattern(args, cli.quiet, cli.verbose),
         Command::Fill(args) => run_fill(args, cli.quiet, cli.verbose),
         Command::Brush(args) => run_brush(args, cli.quiet, cli.verbose),
+        Command::Decorate(args) => run_decorate(args, cli.quiet, cli.verbose),
         Command::Diff(args) => run_diff(args, cli.quiet),
         Command::Style(StyleArgs {
             command: StyleCommand::Check(args),
@@ -429,6 +463,7 @@ fn run_pattern(args: PatternArgs, quiet: bool, verbose: bool) -> Result<(), Fail
             .load_named(&sk, StyleKind::Pattern, &load)
             .and_then(|named| flourish::pattern(&sk, Styles::new(&style, &named), &opts))
             .map_err(|e| e.in_file(shown(sketch)))?;
+        let out = kept(out, &sk, args.keep_sketch);
         Ok(report(sketch, out, quiet, verbose))
     };
     run_batch(&args.sketches, &args.out, quiet, &job)
@@ -470,6 +505,7 @@ fn run_fill(args: FillArgs, quiet: bool, verbose: bool) -> Result<(), Failure> {
             .load_named(&sk, StyleKind::Fill, &load)
             .and_then(|named| flourish::fill(&sk, Styles::new(&style, &named), &opts))
             .map_err(|e| e.in_file(shown(sketch)))?;
+        let out = kept(out, &sk, args.keep_sketch);
         Ok(report(sketch, out, quiet, verbose))
     };
     run_batch(&args.sketches, &args.out, quiet, &job)
@@ -518,6 +554,7 @@ fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
         let job = |sketch: &Path| -> Result<String, Error> {
             let sk = load_sketch(sketch, quiet, verbose)?;
             let out = flourish::brush(&sk, &style, &opts).map_err(|e| e.in_file(shown(sketch)))?;
+            let out = kept(out, &sk, args.keep_sketch);
             Ok(report(sketch, out, quiet, verbose))
         };
         let suffixed = |p: &Path| -> PathBuf {
@@ -550,6 +587,72 @@ fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
         )?;
     }
     Ok(())
+}
+
+/// `out` laid over its sketch when `keep` (`--keep-sketch`).
+fn kept(out: Output, sketch: &Sketch, keep: bool) -> Output {
+    if keep {
+        out.over(sketch)
+    } else {
+        out
+    }
+}
+
+fn run_decorate(args: DecorateArgs, quiet: bool, verbose: bool) -> Result<(), Failure> {
+    let opts = DecorateOptions {
+        brush: BrushOptions {
+            seed: args.out.seed,
+            measure: verbose,
+            ..BrushOptions::default()
+        },
+        fill: FillOptions {
+            seed: args.out.seed,
+            ..FillOptions::default()
+        },
+        pattern: PatternOptions {
+            seed: args.out.seed,
+            ..PatternOptions::default()
+        },
+    };
+    opts.validate()?;
+    let lib = library(&args.styles);
+    let load = StyleOptions {
+        cache_dir: args.cache.clone(),
+        ..StyleOptions::default()
+    };
+    let strokes = args
+        .strokes
+        .as_deref()
+        .map(|s| lib.load(s, &load))
+        .transpose()?;
+    let regions = args
+        .regions
+        .as_deref()
+        .map(|s| lib.load(s, &load))
+        .transpose()?;
+    let none = Default::default();
+    Decoration {
+        strokes: strokes.as_ref(),
+        regions: regions.as_ref(),
+        named: &none,
+    }
+    .validate()?;
+    let job = |sketch: &Path| -> Result<String, Error> {
+        let sk = load_sketch(sketch, quiet, verbose)?;
+        let out = lib
+            .load_every_named(&sk, &load)
+            .and_then(|named| {
+                let styles = Decoration {
+                    strokes: strokes.as_ref(),
+                    regions: regions.as_ref(),
+                    named: &named,
+                };
+                flourish::decorate(&sk, styles, &opts)
+            })
+            .map_err(|e| e.in_file(shown(sketch)))?;
+        Ok(report(sketch, out, quiet, verbose))
+    };
+    run_batch(&args.sketches, &args.out, quiet, &job)
 }
 
 /// [`run_jobs`] with the output options as given (no variation suffix).

@@ -7,8 +7,11 @@
 //! coordinates first and relative offsets are differences of quantized
 //! integers, so rounding never accumulates along a path.
 
-use kurbo::{BezPath, PathEl, Point, Rect};
+use kurbo::{Affine, BezPath, PathEl, Point, Rect};
+use std::collections::BTreeMap;
 use std::fmt::Write as _;
+use std::ops::Range;
+use std::sync::Arc;
 
 /// An sRGB colour, 8 bits per channel.
 #[derive(
@@ -141,6 +144,33 @@ pub struct Document {
     /// Decimals written for coordinates: enough that rounding moves a
     /// point by at most a tenth of the tracing tolerance.
     pub decimals: u32,
+    /// The sketch the groups are laid over, when the output keeps it.
+    pub(crate) backdrop: Option<Arc<Backdrop>>,
+}
+
+/// A sketch's own SVG text, and where the element of each query stands in
+/// it: what an output that keeps the sketch is written into.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub(crate) struct Backdrop {
+    /// The sketch's SVG text (SVGZ inflated).
+    pub(crate) text: String,
+    /// Byte offset of the root element's closing tag: where ornament that
+    /// has no place of its own goes.
+    pub(crate) end: usize,
+    /// By query id, the element the query was read from.
+    pub(crate) places: BTreeMap<String, Place>,
+}
+
+/// Where a query's element stands in its sketch's text.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Place {
+    /// Its bytes, start tag to end tag.
+    pub(crate) range: Range<usize>,
+    /// Its `transform` attribute as written, if any.
+    pub(crate) transform: Option<String>,
+    /// Its own coordinates (with that transform) to the sketch's user
+    /// units.
+    pub(crate) to_user: Affine,
 }
 
 /// Most `<path>` elements an output holds before the shapes of a group
@@ -257,6 +287,7 @@ impl Document {
             view_box: Rect::new(0.0, 0.0, width, height),
             groups: Vec::new(),
             decimals,
+            backdrop: None,
         }
     }
 
@@ -270,8 +301,12 @@ impl Document {
             .sum()
     }
 
-    /// Serializes the document.
+    /// Serializes the document: on its own, or laid over the sketch it
+    /// keeps, each group in place of the shape it decorates.
     pub fn to_svg(&self) -> String {
+        if let Some(b) = &self.backdrop {
+            return self.laid_over(b);
+        }
         let mut out = String::with_capacity(4096);
         let vb = &self.view_box;
         // Sizes keep four significant digits however small the document
@@ -302,49 +337,138 @@ impl Document {
             } else {
                 let _ = writeln!(out, "<g id=\"{}\">", escape_attr(&g.id));
             }
-            for s in &g.shapes {
-                let data = path_data(&s.path, self.decimals);
-                if data.is_empty() {
-                    continue;
-                }
-                out.push_str("<path");
-                match s.fill {
-                    Some(c) => {
-                        let _ = write!(out, " fill=\"{}\"", c.to_hex());
-                        let rule = match s.fill_rule {
-                            FillRule::NonZero => "nonzero",
-                            FillRule::EvenOdd => "evenodd",
-                        };
-                        let _ = write!(out, " fill-rule=\"{rule}\"");
-                    }
-                    None => out.push_str(" fill=\"none\""),
-                }
-                if let Some(st) = &s.stroke {
-                    let _ = write!(
-                        out,
-                        " stroke=\"{}\" stroke-width=\"{}\"",
-                        st.color.to_hex(),
-                        fmt_num(st.width, d)
-                    );
-                    match st.cap {
-                        LineCap::Butt => {}
-                        LineCap::Round => out.push_str(" stroke-linecap=\"round\""),
-                        LineCap::Square => out.push_str(" stroke-linecap=\"square\""),
-                    }
-                    match st.join {
-                        LineJoin::Miter => {}
-                        LineJoin::Round => out.push_str(" stroke-linejoin=\"round\""),
-                        LineJoin::Bevel => out.push_str(" stroke-linejoin=\"bevel\""),
-                    }
-                }
-                if s.opacity < 1.0 {
-                    let _ = write!(out, " opacity=\"{}\"", fmt_num(s.opacity.max(0.0), 3));
-                }
-                let _ = writeln!(out, " d=\"{data}\"/>");
-            }
+            self.write_shapes(&g.shapes, d, &mut out);
             out.push_str("</g>\n");
         }
         out.push_str("</svg>\n");
+        out
+    }
+
+    /// Writes `shapes` as `<path>` elements, stroke widths with `d`
+    /// decimals.
+    fn write_shapes(&self, shapes: &[Shape], d: u32, out: &mut String) {
+        for s in shapes {
+            let data = path_data(&s.path, self.decimals);
+            if data.is_empty() {
+                continue;
+            }
+            out.push_str("<path");
+            match s.fill {
+                Some(c) => {
+                    let _ = write!(out, " fill=\"{}\"", c.to_hex());
+                    let rule = match s.fill_rule {
+                        FillRule::NonZero => "nonzero",
+                        FillRule::EvenOdd => "evenodd",
+                    };
+                    let _ = write!(out, " fill-rule=\"{rule}\"");
+                }
+                None => out.push_str(" fill=\"none\""),
+            }
+            if let Some(st) = &s.stroke {
+                let _ = write!(
+                    out,
+                    " stroke=\"{}\" stroke-width=\"{}\"",
+                    st.color.to_hex(),
+                    fmt_num(st.width, d)
+                );
+                match st.cap {
+                    LineCap::Butt => {}
+                    LineCap::Round => out.push_str(" stroke-linecap=\"round\""),
+                    LineCap::Square => out.push_str(" stroke-linecap=\"square\""),
+                }
+                match st.join {
+                    LineJoin::Miter => {}
+                    LineJoin::Round => out.push_str(" stroke-linejoin=\"round\""),
+                    LineJoin::Bevel => out.push_str(" stroke-linejoin=\"bevel\""),
+                }
+            }
+            if s.opacity < 1.0 {
+                let _ = write!(out, " opacity=\"{}\"", fmt_num(s.opacity.max(0.0), 3));
+            }
+            let _ = writeln!(out, " d=\"{data}\"/>");
+        }
+    }
+
+    /// The backdrop's text with each group in place of its query's
+    /// element, wrapped in the inverse of that element's placement so the
+    /// group's user-unit paths land where the element was drawn; groups
+    /// without a place go last, before the root's closing tag. Paint that
+    /// the group would inherit from its ancestors is reset.
+    fn laid_over(&self, b: &Backdrop) -> String {
+        const RESET: &str =
+            "fill-opacity=\"1\" stroke=\"none\" stroke-opacity=\"1\" stroke-dasharray=\"none\"";
+        let d = self.decimals.max(2);
+        let mut placed: Vec<(Range<usize>, String)> = Vec::new();
+        let mut last = String::new();
+        for g in &self.groups {
+            let id = if g.id.is_empty() {
+                String::new()
+            } else {
+                format!(" id=\"{}\"", escape_attr(&g.id))
+            };
+            let place = b
+                .places
+                .get(&g.id)
+                .filter(|p| p.to_user.determinant().abs() > 1e-12);
+            let mut text = String::new();
+            match place {
+                Some(p) => {
+                    // The placement is read in single precision: six
+                    // decimals of its linear part and four of its offset
+                    // (in user units) hold all it knows.
+                    let c = p.to_user.inverse().as_coeffs();
+                    let m: Vec<String> = (0..6)
+                        .map(|i| fmt_num(c[i], if i < 4 { 6 } else { 4 }))
+                        .collect();
+                    let matrix = if m == ["1", "0", "0", "1", "0", "0"] {
+                        String::new()
+                    } else {
+                        format!(" transform=\"matrix({})\"", m.join(" "))
+                    };
+                    let mut close = "</g>";
+                    // The element's own transform, as written, then the
+                    // inverse of where it placed the element.
+                    match &p.transform {
+                        Some(t) if matrix.is_empty() => {
+                            let t = escape_attr(t);
+                            let _ = writeln!(text, "<g{id} transform=\"{t}\" {RESET}>");
+                        }
+                        Some(t) => {
+                            let t = escape_attr(t);
+                            let _ = writeln!(text, "<g{id} transform=\"{t}\" {RESET}><g{matrix}>");
+                            close = "</g></g>";
+                        }
+                        None => {
+                            let _ = writeln!(text, "<g{id}{matrix} {RESET}>");
+                        }
+                    }
+                    self.write_shapes(&g.shapes, d, &mut text);
+                    text.push_str(close);
+                    placed.push((p.range.clone(), text));
+                }
+                None => {
+                    let _ = writeln!(last, "<g{id} {RESET}>");
+                    self.write_shapes(&g.shapes, d, &mut last);
+                    last.push_str("</g>\n");
+                }
+            }
+        }
+        placed.sort_by_key(|(r, _)| r.start);
+        let mut out = String::with_capacity(
+            b.text.len() + placed.iter().map(|p| p.1.len()).sum::<usize>() + last.len(),
+        );
+        let mut at = 0;
+        for (r, text) in &placed {
+            if r.start < at || r.end > b.end {
+                continue;
+            }
+            out.push_str(&b.text[at..r.start]);
+            out.push_str(text);
+            at = r.end;
+        }
+        out.push_str(&b.text[at..b.end]);
+        out.push_str(&last);
+        out.push_str(&b.text[b.end..]);
         out
     }
 }

@@ -17,17 +17,19 @@
 
 use crate::error::{Error, Result};
 use crate::read::svg::{affine_of, to_bezpath};
-use crate::svg_out::FillRule;
+use crate::svg_out::{Backdrop, FillRule, Place};
 use kurbo::{Affine, BezPath, Rect, Shape as _};
 use resvg::usvg;
 use std::collections::BTreeMap;
+use std::sync::Arc;
 
 /// Largest coordinate magnitude of a query, user units: sizes, lengths and
 /// element counts are computed from the coordinates, and past this a
 /// drawing's numbers (an arc of 1e308) only make them overflow.
 pub const MAX_COORD: f64 = 1e9;
 
-/// Prefix of the ids given to shapes that carry `data-style` but no `id`.
+/// Prefix of the ids given to shapes without one, so each query can be
+/// traced back to its element.
 const PRIVATE_ID: &str = "flourish-ds-";
 
 /// What a query asks for.
@@ -87,6 +89,13 @@ pub struct Sketch {
     /// Shapes the designer drew that cannot be used (no length, zero
     /// stroke width), one line each, printed unless `--quiet`.
     pub warnings: Vec<String>,
+    /// The text it was read from and where each query's element stands in
+    /// it, for an output that keeps the rest of the sketch; `None` for a
+    /// sketch made in code.
+    pub(crate) backdrop: Option<Arc<Backdrop>>,
+    /// The warning that the sketch draws text an output without the
+    /// sketch leaves out.
+    pub(crate) text_left_out: Option<&'static str>,
 }
 
 impl Sketch {
@@ -159,11 +168,21 @@ pub fn parse(data: &[u8]) -> Result<Sketch> {
         queries: Vec::new(),
         notes: Vec::new(),
         warnings: Vec::new(),
+        backdrop: None,
+        text_left_out: None,
     };
-    walk(tree.root(), to_user, &pre.styles, &mut sketch);
-    sketch
-        .warnings
-        .extend(crate::read::svg::text_left_out(data).map(String::from));
+    let mut read = Read {
+        styles: &pre.styles,
+        elements: &pre.elements,
+        backdrop: Backdrop {
+            text: text.to_string(),
+            end: pre.end,
+            places: BTreeMap::new(),
+        },
+    };
+    walk(tree.root(), to_user, &mut read, &mut sketch);
+    sketch.backdrop = Some(Arc::new(read.backdrop));
+    sketch.text_left_out = crate::read::svg::text_left_out(data);
     Ok(sketch)
 }
 
@@ -173,7 +192,31 @@ struct Preprocessed {
     aspect: String,
     /// element id → data-style
     styles: BTreeMap<String, String>,
+    /// element id → where it stands in the text, for elements that can be
+    /// replaced in place (drawn where they stand, their id unique)
+    elements: BTreeMap<String, Element>,
+    /// byte offset of the root's closing tag
+    end: usize,
 }
+
+/// A shape element of the sketch's text.
+struct Element {
+    /// Its bytes, start tag to end tag.
+    range: std::ops::Range<usize>,
+    /// Its `transform` attribute as written.
+    transform: Option<String>,
+}
+
+/// What the walk over usvg's tree reads from and writes to besides the
+/// sketch.
+struct Read<'a> {
+    styles: &'a BTreeMap<String, String>,
+    elements: &'a BTreeMap<String, Element>,
+    backdrop: Backdrop,
+}
+
+/// Elements whose content is drawn only where it is used, elsewhere.
+const REFERENCED: [&str; 6] = ["defs", "symbol", "clipPath", "mask", "pattern", "marker"];
 
 const SHAPES: [&str; 7] = [
     "path", "rect", "circle", "ellipse", "line", "polyline", "polygon",
@@ -190,9 +233,19 @@ fn preprocess(text: &str) -> Result<Preprocessed> {
         .unwrap_or("xMidYMid meet")
         .to_string();
     let mut styles = BTreeMap::new();
+    let mut elements = BTreeMap::new();
+    let mut seen = std::collections::BTreeSet::new();
+    let mut twice = std::collections::BTreeSet::new();
     // (byte offset just after the tag name, id to insert)
     let mut inserts: Vec<(usize, String)> = Vec::new();
     for node in root.descendants().filter(|n| n.is_element()) {
+        if let Some(id) = node.attribute("id") {
+            // An id given twice names no one element.
+            if !seen.insert(id) {
+                twice.insert(id.to_string());
+                elements.remove(id);
+            }
+        }
         if !SHAPES.contains(&node.tag_name().name()) {
             continue;
         }
@@ -200,7 +253,6 @@ fn preprocess(text: &str) -> Result<Preprocessed> {
             .ancestors()
             .filter(|a| a.is_element())
             .find_map(|a| a.attribute("data-style"));
-        let Some(style) = style else { continue };
         let id = match node.attribute("id") {
             Some(id) if !id.is_empty() => id.to_string(),
             _ => {
@@ -214,7 +266,21 @@ fn preprocess(text: &str) -> Result<Preprocessed> {
                 id
             }
         };
-        styles.insert(id, style.to_string());
+        if let Some(style) = style {
+            styles.insert(id.clone(), style.to_string());
+        }
+        let referenced = node
+            .ancestors()
+            .any(|a| REFERENCED.contains(&a.tag_name().name()));
+        if !referenced && !twice.contains(&id) {
+            elements.insert(
+                id,
+                Element {
+                    range: node.range(),
+                    transform: node.attribute("transform").map(str::to_string),
+                },
+            );
+        }
     }
     let mut out = String::with_capacity(text.len() + inserts.len() * 24);
     let mut last = 0;
@@ -229,7 +295,19 @@ fn preprocess(text: &str) -> Result<Preprocessed> {
         view_box,
         aspect,
         styles,
+        elements,
+        end: closing_tag(text, root.range()),
     })
+}
+
+/// The byte offset of the closing tag of the element spanning `range` (its
+/// end when it closes itself).
+fn closing_tag(text: &str, range: std::ops::Range<usize>) -> usize {
+    let own = &text[range.clone()];
+    if own.ends_with("/>") {
+        return range.end;
+    }
+    own.rfind("</").map_or(range.end, |i| range.start + i)
 }
 
 fn parse_view_box(s: &str) -> Option<Rect> {
@@ -279,18 +357,40 @@ fn viewport_to_user(vb: Rect, width: f64, height: f64, aspect: &str) -> Affine {
     to_viewport.inverse()
 }
 
-fn walk(group: &usvg::Group, to_user: Affine, styles: &BTreeMap<String, String>, sk: &mut Sketch) {
+fn walk(group: &usvg::Group, to_user: Affine, read: &mut Read, sk: &mut Sketch) {
     for node in group.children() {
         match node {
-            usvg::Node::Group(g) => walk(g, to_user, styles, sk),
+            usvg::Node::Group(g) => walk(g, to_user, read, sk),
             usvg::Node::Image(_) => sk.notes.push("an image is ignored".into()),
             usvg::Node::Text(_) => sk.notes.push("a text element is ignored".into()),
-            usvg::Node::Path(p) => add_path(p, to_user, styles, sk),
+            usvg::Node::Path(p) => add_path(p, to_user, read, sk),
         }
     }
 }
 
-fn add_path(p: &usvg::Path, to_user: Affine, styles: &BTreeMap<String, String>, sk: &mut Sketch) {
+impl Read<'_> {
+    /// Records that query `id` was read from element `element`, drawn
+    /// with `to_user`: the first query of an element takes its place (a
+    /// `<use>` may draw it again elsewhere).
+    fn place(&mut self, id: &str, element: &str, to_user: Affine) {
+        let Some(el) = self.elements.get(element) else {
+            return;
+        };
+        if self.backdrop.places.values().any(|p| p.range == el.range) {
+            return;
+        }
+        self.backdrop.places.insert(
+            id.to_string(),
+            Place {
+                range: el.range.clone(),
+                transform: el.transform.clone(),
+                to_user,
+            },
+        );
+    }
+}
+
+fn add_path(p: &usvg::Path, to_user: Affine, read: &mut Read, sk: &mut Sketch) {
     let label = if p.id().is_empty() || p.id().starts_with(PRIVATE_ID) {
         "an unnamed shape".to_string()
     } else {
@@ -324,7 +424,8 @@ fn add_path(p: &usvg::Path, to_user: Affine, styles: &BTreeMap<String, String>, 
     } else {
         p.id().to_string()
     };
-    let style = styles.get(p.id()).cloned();
+    let style = read.styles.get(p.id()).cloned();
+    read.place(&id, p.id(), abs);
     if let Some(fill) = p.fill() {
         let fill_rule = match fill.rule() {
             usvg::FillRule::NonZero => FillRule::NonZero,
