@@ -95,7 +95,7 @@ pub fn brush<'a>(
     opts: &BrushOptions,
 ) -> Result<Output> {
     let style = styles.into().default_style().brush()?;
-    in_px(sketch, |sk| brush::run(style, sk, opts)).map(finish)
+    in_px(sketch, 1.0, |sk| brush::run(style, sk, opts)).map(finish)
 }
 
 /// Fills every filled shape of `sketch` with an art pattern synthesized
@@ -122,8 +122,9 @@ pub fn fill<'a>(
     opts: &FillOptions,
 ) -> Result<Output> {
     let styles = styles.into();
+    opts.validate()?;
     // A direction sketch overlays the sketch: the same units.
-    let k = sketch.px_per_unit();
+    let k = sketch.px_per_unit() / opts.scale;
     let scaled;
     let opts = if (k - 1.0).abs() > 1e-9 && opts.direction.is_some() {
         scaled = FillOptions {
@@ -134,7 +135,7 @@ pub fn fill<'a>(
     } else {
         opts
     };
-    let out = in_px(sketch, |sk| {
+    let out = in_px(sketch, opts.scale, |sk| {
         let out = fill::fill_sketch(
             sk,
             |q| {
@@ -176,7 +177,8 @@ pub fn pattern<'a>(
     opts: &PatternOptions,
 ) -> Result<Output> {
     let styles = styles.into();
-    let out = in_px(sketch, |sk| {
+    opts.validate()?;
+    let out = in_px(sketch, opts.scale, |sk| {
         let out = pattern::synthesize_sketch(sk, |q| Ok(styles.of(q)?.pattern()?.clone()), opts)?;
         Ok(Output::new(out.to_document()))
     })?;
@@ -424,9 +426,14 @@ pub fn trace(image: &Image, opts: &TraceOptions) -> Result<Output> {
 /// Runs a mode on `sketch` in CSS pixels: a sketch drawn in millimetres
 /// or points is scaled to pixels first and the output scaled back, so
 /// styles (whose sizes are pixels) give the same drawing whatever the
-/// sketch's units.
-fn in_px(sketch: &Sketch, run: impl FnOnce(&Sketch) -> Result<Output>) -> Result<Output> {
-    let k = sketch.px_per_unit();
+/// sketch's units; and `scale` times smaller, so the style's pattern comes
+/// out `scale` times larger.
+fn in_px(
+    sketch: &Sketch,
+    scale: f64,
+    run: impl FnOnce(&Sketch) -> Result<Output>,
+) -> Result<Output> {
+    let k = sketch.px_per_unit() / scale;
     let mut out = if (k - 1.0).abs() <= 1e-9 {
         run(sketch)?
     } else {

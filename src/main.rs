@@ -130,6 +130,9 @@ struct FillArgs {
     /// An SVG of open stroked paths that comb the pattern's direction in every region.
     #[arg(long, value_name = "D.svg")]
     direction: Option<PathBuf>,
+    /// Draw the pattern this many times larger (multiplies the style's scale), 0.01..=100.
+    #[arg(long, default_value_t = 1.0, value_name = "F")]
+    scale: f64,
     /// Tile raster size in pixels (longest side), overriding the style's.
     #[arg(long, value_name = "PX")]
     resolution: Option<u32>,
@@ -188,6 +191,9 @@ struct PatternArgs {
     /// How much repeated elements vary in place and turn (Barla et al. §3.3), 0..1.
     #[arg(long, alias = "variation", default_value_t = 0.0, value_name = "0..1")]
     jitter: f64,
+    /// Draw the elements and their spacing this many times larger, 0.01..=100.
+    #[arg(long, default_value_t = 1.0, value_name = "F")]
+    scale: f64,
 }
 
 #[derive(Args)]
@@ -448,6 +454,7 @@ fn run_pattern(args: PatternArgs, quiet: bool, verbose: bool) -> Result<(), Fail
     let opts = PatternOptions {
         seed: args.out.seed,
         variation: args.jitter,
+        scale: args.scale,
         ..PatternOptions::default()
     };
     opts.validate()?;
@@ -494,6 +501,7 @@ fn run_fill(args: FillArgs, quiet: bool, verbose: bool) -> Result<(), Failure> {
     let opts = FillOptions {
         seed: args.out.seed,
         direction,
+        scale: args.scale,
         ..FillOptions::default()
     };
     opts.validate()?;

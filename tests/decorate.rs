@@ -3,9 +3,7 @@
 //! (by id, in drawing order), every query is decorated in place of its
 //! element, and the ornament lands where the mode alone puts it.
 
-use flourish::{
-    DecorateOptions, Decoration, Library, PatternOptions, Sketch, StyleOptions,
-};
+use flourish::{DecorateOptions, Decoration, Library, PatternOptions, Sketch, StyleOptions};
 use resvg::usvg;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -40,7 +38,12 @@ const CARD: &str = r##"<svg xmlns="http://www.w3.org/2000/svg" width="320" heigh
 fn ids(svg: &str) -> BTreeMap<String, String> {
     let doc = usvg::roxmltree::Document::parse(svg).expect("well-formed output");
     doc.descendants()
-        .filter_map(|n| Some((n.attribute("id")?.to_string(), n.tag_name().name().to_string())))
+        .filter_map(|n| {
+            Some((
+                n.attribute("id")?.to_string(),
+                n.tag_name().name().to_string(),
+            ))
+        })
         .collect()
 }
 
@@ -89,7 +92,11 @@ fn decorate_keeps_every_other_element_and_decorates_every_query() {
     assert!(at("title") < at("swoosh") && at("swoosh") < at("vine-line"));
     assert!(at("sun") < at("leaf"));
     // The text the output keeps is not reported as left out.
-    assert!(out.warnings.iter().all(|w| !w.contains("text")), "{:?}", out.warnings);
+    assert!(
+        out.warnings.iter().all(|w| !w.contains("text")),
+        "{:?}",
+        out.warnings
+    );
     // The result renders.
     flourish::preview_png(&svg).expect("the decorated card renders");
 }
@@ -99,8 +106,8 @@ fn decorate_keeps_every_other_element_and_decorates_every_query() {
 #[test]
 fn ornament_lands_where_the_mode_alone_puts_it() {
     let (_, out) = decorate_card();
-    let composed = usvg::Tree::from_str(&out.to_svg(), &usvg::Options::default())
-        .expect("the output parses");
+    let composed =
+        usvg::Tree::from_str(&out.to_svg(), &usvg::Options::default()).expect("the output parses");
     let only = Sketch::from_svg(
         CARD.replace(r#" data-style="vine""#, "")
             .replace(r#" data-style="stipple""#, "")
@@ -145,7 +152,11 @@ fn keep_sketch_lays_a_single_mode_over_its_sketch() {
         .arg(&sketch)
         .output()
         .expect("runs");
-    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
     assert!(
         !String::from_utf8_lossy(&run.stderr).contains("text"),
         "the kept text is not reported as left out"
@@ -180,7 +191,10 @@ fn decorate_refuses_a_style_of_the_wrong_kind_as_usage() {
         .expect("runs");
     assert_eq!(run.status.code(), Some(2));
     let err = String::from_utf8_lossy(&run.stderr);
-    assert!(err.contains("--strokes") && err.contains("fill style"), "{err}");
+    assert!(
+        err.contains("--strokes") && err.contains("fill style"),
+        "{err}"
+    );
     assert!(!out.exists(), "no output written");
 }
 
@@ -206,7 +220,9 @@ fn shapes_without_a_place_or_a_fitting_style() {
     };
     let out = flourish::decorate(&sketch, styles, &DecorateOptions::default()).expect("decorates");
     assert!(
-        out.warnings.iter().any(|w| w.contains("box") && w.contains("kept as drawn")),
+        out.warnings
+            .iter()
+            .any(|w| w.contains("box") && w.contains("kept as drawn")),
         "{:?}",
         out.warnings
     );

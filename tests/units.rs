@@ -105,3 +105,52 @@ fn a_sketch_in_mm_or_pt_gives_the_px_result_scaled() {
         "brush/short.svg",
     );
 }
+
+/// `scale` (`--scale F`) draws a pattern style's elements F times larger:
+/// each element is a rigid copy, so the largest is exactly twice as wide;
+/// a fill style's pattern comes out coarser, with fewer shapes.
+#[test]
+fn scale_draws_the_style_larger() {
+    let lib = Library::shipped();
+    let load = StyleOptions::default();
+    let sketch = Sketch::from_svg(
+        &std::fs::read(root().join("samples/pattern/blob.svg")).expect("the blob sample"),
+    )
+    .expect("parses");
+    let flowers = lib.load("flowers", &load).expect("flowers");
+    let largest = |scale: f64| -> f64 {
+        let opts = PatternOptions {
+            scale,
+            ..PatternOptions::default()
+        };
+        let out = flourish::pattern(&sketch, &flowers, &opts).expect("pattern");
+        out.document
+            .groups
+            .iter()
+            .flat_map(|g| &g.shapes)
+            .map(|s| kurbo::Shape::bounding_box(&s.path).width())
+            .fold(0.0, f64::max)
+    };
+    let (one, two) = (largest(1.0), largest(2.0));
+    assert!((two / one - 2.0).abs() < 0.02, "{one} → {two}");
+
+    let circle = Sketch::from_svg(
+        &std::fs::read(root().join("samples/fill/circle.svg")).expect("the circle sample"),
+    )
+    .expect("parses");
+    let scales = lib.load("scales", &load).expect("scales");
+    let fill = |scale: f64| {
+        let opts = FillOptions {
+            scale,
+            ..FillOptions::default()
+        };
+        shapes(&flourish::fill(&circle, &scales, &opts).expect("fill"))
+    };
+    let (one, two) = (fill(1.0), fill(2.0));
+    assert!(two * 2 < one, "{one} shapes at 1, {two} at 2");
+    let bad = FillOptions {
+        scale: 0.0,
+        ..FillOptions::default()
+    };
+    assert!(flourish::fill(&circle, &scales, &bad).is_err());
+}

@@ -68,6 +68,9 @@ pub struct FillOptions {
     /// Largest distance of the traced curves from the synthesized outline,
     /// in synthesis pixels (0.01..=100; default 0.25).
     pub tolerance: f64,
+    /// Multiplies the style's `scale`: the pattern drawn this many times
+    /// larger in the sketch (0.01..=100; default 1).
+    pub scale: f64,
 }
 
 impl Default for FillOptions {
@@ -76,6 +79,7 @@ impl Default for FillOptions {
             seed: 0,
             direction: None,
             tolerance: 0.25,
+            scale: 1.0,
         }
     }
 }
@@ -83,6 +87,12 @@ impl Default for FillOptions {
 impl FillOptions {
     /// Checks every value's range, and that a direction sketch combs.
     pub fn validate(&self) -> Result<()> {
+        if !(self.scale.is_finite() && (0.01..=100.0).contains(&self.scale)) {
+            return Err(Error::Option {
+                name: "scale",
+                reason: format!("{} is not in 0.01..=100", self.scale),
+            });
+        }
         if !(self.tolerance.is_finite() && (0.01..=100.0).contains(&self.tolerance)) {
             return Err(Error::Option {
                 name: "tolerance",

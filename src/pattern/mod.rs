@@ -51,6 +51,9 @@ pub struct PatternOptions {
     /// Largest number of elements one query may ask for; more is an error
     /// (default 50 000).
     pub max_elements: usize,
+    /// Multiplies the style's size: its elements and their spacing drawn
+    /// this many times larger in the sketch (0.01..=100; default 1).
+    pub scale: f64,
 }
 
 impl Default for PatternOptions {
@@ -59,6 +62,7 @@ impl Default for PatternOptions {
             seed: 0,
             variation: 0.0,
             max_elements: DEFAULT_MAX_ELEMENTS,
+            scale: 1.0,
         }
     }
 }
@@ -66,6 +70,12 @@ impl Default for PatternOptions {
 impl PatternOptions {
     /// Checks every value's range.
     pub fn validate(&self) -> Result<()> {
+        if !(self.scale.is_finite() && (0.01..=100.0).contains(&self.scale)) {
+            return Err(Error::Option {
+                name: "scale",
+                reason: format!("{} is not in 0.01..=100", self.scale),
+            });
+        }
         if !(self.variation.is_finite() && (0.0..=1.0).contains(&self.variation)) {
             return Err(Error::Option {
                 name: "variation",

@@ -50,6 +50,7 @@ fn synth(job: &Job, sk: &Sketch) -> Result<PatternOutput> {
         seed: job.seed,
         variation: job.variation,
         max_elements: job.max_elements.unwrap_or(super::DEFAULT_MAX_ELEMENTS),
+        ..PatternOptions::default()
     };
     synthesize_sketch(sk, |q| Ok(styles.of(q)?.pattern()?.clone()), &opts)
 }
