@@ -6,6 +6,35 @@
 use crate::error::{Error, Result};
 use std::io::Write as _;
 use std::path::Path;
+use std::sync::Mutex;
+
+/// Held while output files are written: whoever ends the process early
+/// takes it first ([`exit_between_writes`]).
+static WRITES: Mutex<()> = Mutex::new(());
+
+/// What the run is doing now, for a progress line ([`stage`]).
+static STAGE: Mutex<String> = Mutex::new(String::new());
+
+/// Ends the process with exit status `code` once no output is being
+/// written, and lets no write begin after: every output file is whole or
+/// absent, and no temporary file is left behind (for `--timeout`).
+pub fn exit_between_writes(code: i32) -> ! {
+    let _writes = WRITES.lock().unwrap_or_else(|p| p.into_inner());
+    std::process::exit(code)
+}
+
+/// The stage the library is in, in a few words (e.g. "fill: 3 regions"):
+/// what a progress line shows. Empty before the first stage.
+pub fn stage() -> String {
+    STAGE.lock().map(|s| s.clone()).unwrap_or_default()
+}
+
+/// Sets the stage [`stage`] reports.
+pub(crate) fn set_stage(what: impl Into<String>) {
+    if let Ok(mut s) = STAGE.lock() {
+        *s = what.into();
+    }
+}
 
 /// Largest input file read, in bytes (256 MiB).
 pub const MAX_FILE_BYTES: u64 = 256 << 20;
@@ -100,6 +129,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
 /// into place, so a missing folder or a full disk leaves no output behind.
 /// A path of `-` writes to standard output.
 pub fn write_all_atomic(files: &[(&Path, &[u8])]) -> Result<()> {
+    let _writes = WRITES.lock().unwrap_or_else(|p| p.into_inner());
     let mut staged = Vec::new();
     for &(path, bytes) in files {
         if path.as_os_str() == "-" {

@@ -95,6 +95,7 @@ pub fn brush<'a>(
     opts: &BrushOptions,
 ) -> Result<Output> {
     let style = styles.into().default_style().brush()?;
+    io::set_stage(format!("brush: {}", count(sketch, "stroke", true)));
     in_px(sketch, 1.0, |sk| brush::run(style, sk, opts)).map(finish)
 }
 
@@ -123,6 +124,7 @@ pub fn fill<'a>(
 ) -> Result<Output> {
     let styles = styles.into();
     opts.validate()?;
+    io::set_stage(format!("fill: {}", count(sketch, "region", false)));
     // A direction sketch overlays the sketch: the same units.
     let k = sketch.px_per_unit() / opts.scale;
     let scaled;
@@ -178,6 +180,7 @@ pub fn pattern<'a>(
 ) -> Result<Output> {
     let styles = styles.into();
     opts.validate()?;
+    io::set_stage(format!("pattern: {} shapes", sketch.queries.len()));
     let out = in_px(sketch, opts.scale, |sk| {
         let out = pattern::synthesize_sketch(sk, |q| Ok(styles.of(q)?.pattern()?.clone()), opts)?;
         Ok(Output::new(out.to_document()))
@@ -395,6 +398,7 @@ pub struct Image {
 impl Image {
     /// Reads raster or SVG bytes (told apart by their content) as ink.
     pub fn from_bytes(bytes: &[u8], opts: &ImageOptions) -> Result<Image> {
+        io::set_stage("reading the picture");
         Ok(Image {
             picture: read::ink::read_traceable(bytes, opts)?,
         })
@@ -420,7 +424,18 @@ impl Image {
 /// # }
 /// ```
 pub fn trace(image: &Image, opts: &TraceOptions) -> Result<Output> {
+    io::set_stage("tracing");
     trace::trace(&image.picture, opts).map(finish)
+}
+
+/// "N strokes" (`paths`) or "N regions" of `sketch`, for a stage line.
+fn count(sketch: &Sketch, what: &str, paths: bool) -> String {
+    let n = sketch
+        .queries
+        .iter()
+        .filter(|q| matches!(q.kind, QueryKind::Path { .. }) == paths)
+        .count();
+    format!("{n} {what}{}", if n == 1 { "" } else { "s" })
 }
 
 /// Runs a mode on `sketch` in CSS pixels: a sketch drawn in millimetres
@@ -473,6 +488,7 @@ pub fn style_sheet(style: &Style) -> Result<Vec<u8>> {
 /// SVG text rendered on white as PNG bytes (documents under 512 px are
 /// enlarged to 512 px): the `--preview` of every command.
 pub fn preview_png(svg: &str) -> Result<Vec<u8>> {
+    io::set_stage("rendering the preview");
     render::preview_png(svg)
 }
 

@@ -97,6 +97,11 @@ impl Style {
         if let Some(want) = opts.kind {
             wrong_kind(dir, kind, want)?;
         }
+        crate::io::set_stage(format!(
+            "reading {} style {name} ({} exemplars)",
+            kind.name(),
+            manifest.exemplar.len()
+        ));
         let loaded = match kind {
             StyleKind::Brush => Loaded::Brush(BrushStyle::load(
                 dir,

@@ -30,6 +30,9 @@ struct Cli {
     /// Worker threads, 1..=1024 (default: one per core); output does not depend on it.
     #[arg(long, global = true, value_name = "N")]
     threads: Option<usize>,
+    /// End the run after this many seconds: exit 1, no output file left half-written.
+    #[arg(long, global = true, value_name = "SECONDS")]
+    timeout: Option<f64>,
 }
 
 #[derive(Subcommand)]
@@ -326,6 +329,24 @@ fn main() -> ExitCode {
 const MAX_THREADS: usize = 1024;
 
 fn run(cli: Cli) -> Result<(), Failure> {
+    if let Some(t) = cli.timeout {
+        if !(t.is_finite() && t > 0.0 && t <= 1e6) {
+            return Err(Failure::Usage(format!(
+                "--timeout {t} is not a number of seconds in (0, 1000000]"
+            )));
+        }
+        std::thread::spawn(move || {
+            std::thread::sleep(std::time::Duration::from_secs_f64(t));
+            let stage = io::stage();
+            let during = if stage.is_empty() {
+                String::new()
+            } else {
+                format!(", during {stage}")
+            };
+            eprintln!("flourish: timed out after {t} s{during} (--timeout)");
+            io::exit_between_writes(1)
+        });
+    }
     if let Some(n) = cli.threads {
         if n == 0 {
             return Err(Failure::Usage("--threads must be at least 1".into()));
@@ -704,6 +725,7 @@ fn run_jobs(
                 ));
             }
             let inp = &inputs[0];
+            let _ticker = Ticker::start(shown(inp), quiet);
             // `-o DIR/` (or an existing folder) writes NAME.svg into it.
             let into = |p: &Path, name: PathBuf| -> Result<PathBuf, Failure> {
                 if names_folder(p) {
@@ -808,6 +830,87 @@ fn run_jobs(
             Ok(())
         }
         _ => Err(Failure::Usage("give -o OUT.svg or --out-dir DIR".into())),
+    }
+}
+
+/// Progress on stderr for a run that lasts: after [`Ticker::after`], the
+/// library's stage ([`io::stage`]) as a spinner on a terminal, else a line
+/// each time the stage changes. Stops (and clears the spinner) when
+/// dropped.
+struct Ticker {
+    done: std::sync::Arc<std::sync::atomic::AtomicBool>,
+    thread: Option<std::thread::JoinHandle<()>>,
+}
+
+impl Ticker {
+    /// How long a run goes before it shows progress: 2 s, or the seconds
+    /// in `$FLOURISH_PROGRESS_AFTER` (the tests set 0).
+    fn after() -> std::time::Duration {
+        std::env::var("FLOURISH_PROGRESS_AFTER")
+            .ok()
+            .and_then(|v| v.parse::<f64>().ok())
+            .filter(|v| v.is_finite() && *v >= 0.0 && *v < 1e6)
+            .map_or(
+                std::time::Duration::from_secs(2),
+                std::time::Duration::from_secs_f64,
+            )
+    }
+
+    /// Starts watching the run on `input`; shows nothing when `quiet`.
+    fn start(input: &Path, quiet: bool) -> Ticker {
+        use std::io::IsTerminal as _;
+        use std::sync::atomic::Ordering;
+        let done = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+        if quiet {
+            return Ticker { done, thread: None };
+        }
+        let input = input.display().to_string();
+        let stop = done.clone();
+        let thread = std::thread::spawn(move || {
+            let tick = std::time::Duration::from_millis(100);
+            let start = std::time::Instant::now();
+            let after = Ticker::after();
+            while start.elapsed() < after {
+                if stop.load(Ordering::Relaxed) {
+                    return;
+                }
+                std::thread::sleep(tick);
+            }
+            let terminal = std::io::stderr().is_terminal();
+            let spinner = terminal.then(|| {
+                let s = ProgressBar::new_spinner();
+                s.enable_steady_tick(tick);
+                s
+            });
+            let mut shown = String::new();
+            while !stop.load(Ordering::Relaxed) {
+                let stage = io::stage();
+                if stage != shown {
+                    match &spinner {
+                        Some(s) => s.set_message(format!("{input}: {stage}")),
+                        None => eprintln!("flourish: {input}: {stage}"),
+                    }
+                    shown = stage;
+                }
+                std::thread::sleep(tick);
+            }
+            if let Some(s) = spinner {
+                s.finish_and_clear();
+            }
+        });
+        Ticker {
+            done,
+            thread: Some(thread),
+        }
+    }
+}
+
+impl Drop for Ticker {
+    fn drop(&mut self) {
+        self.done.store(true, std::sync::atomic::Ordering::Relaxed);
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
     }
 }
 
