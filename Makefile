@@ -3,7 +3,7 @@ CARGO ?= cargo
 BIN := target/release/flourish
 OUT := out
 
-.PHONY: demo test gallery golden bench lint deps clean
+.PHONY: demo test gallery golden bench lint deps clean fuzz-smoke
 
 # Everything the tests need that cargo does not install: potrace, the
 # reference tracer the trace tests compare against (Debian package).
@@ -83,3 +83,19 @@ lint:
 
 clean:
 	rm -rf $(OUT) golden/.failed
+
+# The readers under libFuzzer (cargo-fuzz on the nightly toolchain, which
+# the target installs): the sketch SVG reader, style.toml, exemplar files
+# and the picture decoders, FUZZ_SECONDS each (default 60) from the seeds
+# in fuzz/seeds/, with a fixed libFuzzer seed. A crash stops here, its
+# input in fuzz/artifacts/.
+FUZZ_SECONDS ?= 60
+FUZZ_TARGETS = sketch_svg style_toml exemplar raster
+fuzz-smoke:
+	@command -v cargo-fuzz >/dev/null 2>&1 || $(CARGO) install cargo-fuzz --locked
+	cd fuzz && $(CARGO) +nightly fuzz build -O
+	cd fuzz && for t in $(FUZZ_TARGETS); do \
+	  mkdir -p corpus/$$t && \
+	  $(CARGO) +nightly fuzz run -O $$t corpus/$$t seeds/$$t -- \
+	    -seed=1 -max_total_time=$(FUZZ_SECONDS) -rss_limit_mb=2048 -timeout=30 -max_len=65536 || exit 1; \
+	done
