@@ -37,7 +37,7 @@ enum Command {
     Trace(TraceArgs),
     /// Arrange hand-drawn stroke elements along open paths and inside filled shapes.
     Pattern(PatternArgs),
-    /// Fill closed shapes with an art pattern synthesized from a tile.
+    /// Fill closed shapes with an art pattern synthesized from a style's swatches.
     Fill(FillArgs),
     /// Grow structured ornament of a brush style along open paths (DecoBrush).
     Brush(BrushArgs),
@@ -115,9 +115,14 @@ struct FillArgs {
     /// An SVG of open stroked paths that comb the pattern's direction in every region.
     #[arg(long, value_name = "D.svg")]
     direction: Option<PathBuf>,
-    /// Tile raster size in pixels (longest side), overriding the style's.
+    /// Swatch raster size in pixels (longest side), overriding the style's.
     #[arg(long, value_name = "PX")]
     resolution: Option<u32>,
+    /// Synthesize every shape from this one swatch of the style (a file
+    /// that style.toml lists) instead of from all of them; a shape's
+    /// data-exemplar="FILE" pins its own.
+    #[arg(long, value_name = "FILE")]
+    exemplar: Option<String>,
 }
 
 #[derive(Args)]
@@ -415,6 +420,7 @@ fn run_fill(args: FillArgs, quiet: bool, verbose: bool) -> Result<(), Failure> {
     let opts = FillOptions {
         seed: args.out.seed,
         direction,
+        exemplar: args.exemplar.clone(),
         ..FillOptions::default()
     };
     opts.validate()?;

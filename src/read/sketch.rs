@@ -6,10 +6,11 @@
 //! - a shape with a visible stroke and no fill is an **open query path**
 //!   (its geometry is the spine, its stroke width the intended width).
 //!
-//! A shape (or an ancestor group) may carry `data-style="NAME"`. usvg drops
-//! unknown attributes, so the raw XML is read first with roxmltree (the
-//! parser usvg itself uses) and shapes carrying a style without an `id` get
-//! a private one, mapped back here.
+//! A shape (or an ancestor group) may carry `data-style="NAME"`, and a
+//! filled one `data-exemplar="FILE"` (one swatch of its fill style). usvg
+//! drops unknown attributes, so the raw XML is read first with roxmltree
+//! (the parser usvg itself uses) and shapes carrying either without an `id`
+//! get a private one, mapped back here.
 //!
 //! Query geometry is in the sketch's user units (its `viewBox` space), so an
 //! output written with the sketch's `width`, `height` and `viewBox`
@@ -22,7 +23,8 @@ use kurbo::{Affine, BezPath, Rect, Shape as _};
 use resvg::usvg;
 use std::collections::BTreeMap;
 
-/// Prefix of the ids given to shapes that carry `data-style` but no `id`.
+/// Prefix of the ids given to shapes that carry `data-style` or
+/// `data-exemplar` but no `id`.
 const PRIVATE_ID: &str = "flourish-ds-";
 
 /// What a query asks for.
@@ -77,6 +79,9 @@ pub struct Sketch {
     pub view_box: Rect,
     /// The queries in document order.
     pub queries: Vec<Query>,
+    /// The `data-exemplar` of a region (of the shape or its nearest
+    /// ancestor), by query id.
+    pub exemplars: BTreeMap<String, String>,
     /// Things ignored, one line each, for `--verbose`.
     pub notes: Vec<String>,
     /// Shapes the designer drew that cannot be used (no length, zero
@@ -116,10 +121,11 @@ pub fn parse(data: &[u8]) -> Result<Sketch> {
         height,
         view_box,
         queries: Vec::new(),
+        exemplars: BTreeMap::new(),
         notes: Vec::new(),
         warnings: Vec::new(),
     };
-    walk(tree.root(), to_user, &pre.styles, &mut sketch);
+    walk(tree.root(), to_user, &pre, &mut sketch);
     sketch
         .warnings
         .extend(crate::read::svg::text_left_out(data).map(String::from));
@@ -132,14 +138,17 @@ struct Preprocessed {
     aspect: String,
     /// element id → data-style
     styles: BTreeMap<String, String>,
+    /// element id → data-exemplar
+    exemplars: BTreeMap<String, String>,
 }
 
 const SHAPES: [&str; 7] = [
     "path", "rect", "circle", "ellipse", "line", "polyline", "polygon",
 ];
 
-/// Reads `viewBox`, `preserveAspectRatio` and `data-style` from the raw XML
-/// and gives styled shapes without an id a private one.
+/// Reads `viewBox`, `preserveAspectRatio`, `data-style` and
+/// `data-exemplar` from the raw XML and gives shapes carrying either
+/// without an id a private one.
 fn preprocess(text: &str) -> Result<Preprocessed> {
     let opts = usvg::roxmltree::ParsingOptions {
         allow_dtd: true,
@@ -154,17 +163,22 @@ fn preprocess(text: &str) -> Result<Preprocessed> {
         .unwrap_or("xMidYMid meet")
         .to_string();
     let mut styles = BTreeMap::new();
+    let mut exemplars = BTreeMap::new();
     // (byte offset just after the tag name, id to insert)
     let mut inserts: Vec<(usize, String)> = Vec::new();
     for node in root.descendants().filter(|n| n.is_element()) {
         if !SHAPES.contains(&node.tag_name().name()) {
             continue;
         }
-        let style = node
-            .ancestors()
-            .filter(|a| a.is_element())
-            .find_map(|a| a.attribute("data-style"));
-        let Some(style) = style else { continue };
+        let inherited = |name: &str| {
+            node.ancestors()
+                .filter(|a| a.is_element())
+                .find_map(|a| a.attribute(name))
+        };
+        let (style, exemplar) = (inherited("data-style"), inherited("data-exemplar"));
+        if style.is_none() && exemplar.is_none() {
+            continue;
+        }
         let id = match node.attribute("id") {
             Some(id) if !id.is_empty() => id.to_string(),
             _ => {
@@ -178,7 +192,12 @@ fn preprocess(text: &str) -> Result<Preprocessed> {
                 id
             }
         };
-        styles.insert(id, style.to_string());
+        if let Some(e) = exemplar {
+            exemplars.insert(id.clone(), e.to_string());
+        }
+        if let Some(style) = style {
+            styles.insert(id, style.to_string());
+        }
     }
     let mut out = String::with_capacity(text.len() + inserts.len() * 24);
     let mut last = 0;
@@ -193,6 +212,7 @@ fn preprocess(text: &str) -> Result<Preprocessed> {
         view_box,
         aspect,
         styles,
+        exemplars,
     })
 }
 
@@ -243,18 +263,18 @@ fn viewport_to_user(vb: Rect, width: f64, height: f64, aspect: &str) -> Affine {
     to_viewport.inverse()
 }
 
-fn walk(group: &usvg::Group, to_user: Affine, styles: &BTreeMap<String, String>, sk: &mut Sketch) {
+fn walk(group: &usvg::Group, to_user: Affine, pre: &Preprocessed, sk: &mut Sketch) {
     for node in group.children() {
         match node {
-            usvg::Node::Group(g) => walk(g, to_user, styles, sk),
+            usvg::Node::Group(g) => walk(g, to_user, pre, sk),
             usvg::Node::Image(_) => sk.notes.push("an image is ignored".into()),
             usvg::Node::Text(_) => sk.notes.push("a text element is ignored".into()),
-            usvg::Node::Path(p) => add_path(p, to_user, styles, sk),
+            usvg::Node::Path(p) => add_path(p, to_user, pre, sk),
         }
     }
 }
 
-fn add_path(p: &usvg::Path, to_user: Affine, styles: &BTreeMap<String, String>, sk: &mut Sketch) {
+fn add_path(p: &usvg::Path, to_user: Affine, pre: &Preprocessed, sk: &mut Sketch) {
     let label = if p.id().is_empty() || p.id().starts_with(PRIVATE_ID) {
         "an unnamed shape".to_string()
     } else {
@@ -278,12 +298,15 @@ fn add_path(p: &usvg::Path, to_user: Affine, styles: &BTreeMap<String, String>, 
     } else {
         p.id().to_string()
     };
-    let style = styles.get(p.id()).cloned();
+    let style = pre.styles.get(p.id()).cloned();
     if let Some(fill) = p.fill() {
         let fill_rule = match fill.rule() {
             usvg::FillRule::NonZero => FillRule::NonZero,
             usvg::FillRule::EvenOdd => FillRule::EvenOdd,
         };
+        if let Some(e) = pre.exemplars.get(p.id()) {
+            sk.exemplars.insert(id.clone(), e.clone());
+        }
         sk.queries.push(Query {
             id,
             style,
@@ -340,5 +363,21 @@ mod tests {
         assert_eq!(s.queries[1].id, "q-2");
         assert_eq!(s.queries[1].style.as_deref(), Some("stipple"));
         assert!(matches!(s.queries[1].kind, QueryKind::Region { .. }));
+        assert!(s.exemplars.is_empty());
+    }
+
+    #[test]
+    fn a_region_may_pin_an_exemplar() {
+        let svg = r##"<svg xmlns="http://www.w3.org/2000/svg" width="200" height="100">
+            <g data-exemplar="b.svg"><rect x="10" y="10" width="50" height="50" fill="#f00"/></g>
+            <circle id="c" cx="150" cy="50" r="30" fill="#00f" data-exemplar="a.svg" data-style="s"/>
+            <rect x="80" y="10" width="20" height="20" fill="#0f0"/>
+        </svg>"##;
+        let s = parse(svg.as_bytes()).unwrap();
+        assert_eq!(s.queries.len(), 3);
+        assert_eq!(s.exemplars.get("q-1").map(String::as_str), Some("b.svg"));
+        assert_eq!(s.exemplars.get("c").map(String::as_str), Some("a.svg"));
+        assert_eq!(s.queries[1].style.as_deref(), Some("s"));
+        assert!(!s.exemplars.contains_key("q-3"));
     }
 }
