@@ -66,6 +66,8 @@ pub struct Quilter {
     dims: (usize, usize),
     /// Allowed block centres.
     centres: Vec<(u32, u32)>,
+    /// How far a turned block reaches from its centre, pixels.
+    reach: usize,
 }
 
 impl Quilter {
@@ -105,6 +107,7 @@ impl Quilter {
             linear,
             dims: (pw, d),
             centres: source.atlas.centres(block_reach(b)),
+            reach: block_reach(b),
         }
     }
 
@@ -229,7 +232,18 @@ fn quilt_blocks(
                         .collect()
                 })
                 .collect();
-            let cands: Vec<(usize, usize, f32)> = chunks.into_iter().flatten().collect();
+            let mut cands: Vec<(usize, usize, f32)> = chunks.into_iter().flatten().collect();
+            if n > o.candidates {
+                let bring = |ox: u32, oy: u32, rx: i64, ry: i64| {
+                    let k = atlas.block_of(oy as usize);
+                    let (x, y) = atlas.bring_in(k, ox as i64 + rx, oy as i64 + ry, q.reach);
+                    atlas.allowed(x, y).then_some((x as usize, y as usize))
+                };
+                let angle = |x: u32, y: u32| source.angle.get(x as usize, y as usize);
+                for (sx, sy) in continuations(&map, &filled, (bx, by), b, ta, angle, bring) {
+                    cands.push((sx, sy, overlap_err(sx, sy, f32::INFINITY)));
+                }
+            }
             let best = cands.iter().map(|c| c.2).fold(f32::INFINITY, f32::min);
             let good: Vec<&(usize, usize, f32)> =
                 cands.iter().filter(|c| c.2 <= keep_bound(best)).collect();
@@ -279,6 +293,45 @@ fn quilt_blocks(
         by += step;
     }
     map
+}
+
+/// The block centres that continue the blocks laid to the left of and
+/// above the block at `(bx, by)` (side `b`): the source of the filled
+/// pixel in the middle of each overlap, moved by that pixel's offset to
+/// the block's centre turned as a block from there is (target angle `ta`,
+/// source angles `angle`), brought into its exemplar by `bring` (`None`
+/// when it may not be a centre). A random sample of centres can miss a
+/// tile's own repeat; these are it.
+fn continuations(
+    map: &Grid<(u32, u32)>,
+    filled: &Grid<bool>,
+    (bx, by): (usize, usize),
+    b: usize,
+    ta: f32,
+    angle: impl Fn(u32, u32) -> f32,
+    bring: impl Fn(u32, u32, i64, i64) -> Option<(usize, usize)>,
+) -> Vec<(usize, usize)> {
+    let (w, h) = (map.width(), map.height());
+    let (cx, cy) = (bx + b / 2, by + b / 2);
+    let mut out = Vec::new();
+    for (px, py) in [(bx, cy.min(h - 1)), (cx.min(w - 1), by)] {
+        if !filled.get(px, py) {
+            continue;
+        }
+        let (ox, oy) = map.get(px, py);
+        let bin = angle_bin(angle(ox, oy) - ta);
+        let a = bin as f32 * std::f32::consts::TAU / ANGLE_BINS as f32;
+        let (sn, cs) = a.sin_cos();
+        let (dx, dy) = (cx as f32 - px as f32, cy as f32 - py as f32);
+        let rx = (cs * dx - sn * dy).round() as i64;
+        let ry = (sn * dx + cs * dy).round() as i64;
+        if let Some(p) = bring(ox, oy, rx, ry) {
+            if !out.contains(&p) {
+                out.push(p);
+            }
+        }
+    }
+    out
 }
 
 /// Candidates whose overlap errors one task computes, with a running best.
@@ -465,12 +518,20 @@ mod tests {
                         .map(|i| (i % sw, i / sw, overlap_err(i % sw, i / sw)))
                         .collect()
                 } else {
+                    let bring = |ox: u32, oy: u32, rx: i64, ry: i64| {
+                        Some((
+                            (ox as i64 + rx).rem_euclid(sw as i64) as usize,
+                            (oy as i64 + ry).rem_euclid(sh as i64) as usize,
+                        ))
+                    };
+                    let angle = |x: u32, y: u32| source_angle.get(x as usize, y as usize);
                     (0..o.candidates.max(1))
                         .map(|k| {
                             let i = rng::index(&[o.seed, bi, k as u64], sw * sh);
-                            let (sx, sy) = (i % sw, i / sw);
-                            (sx, sy, overlap_err(sx, sy))
+                            (i % sw, i / sw)
                         })
+                        .chain(continuations(&map, &filled, (bx, by), b, ta, angle, bring))
+                        .map(|(sx, sy)| (sx, sy, overlap_err(sx, sy)))
                         .collect()
                 };
                 let best = cands.iter().map(|c| c.2).fold(f32::INFINITY, f32::min);

@@ -601,6 +601,29 @@ impl Tile {
         }
     }
 
+    /// The tile with each layer's ink grown by `by[l]` pixels (its SDF
+    /// lowered by as much), the composite colour redrawn.
+    pub fn grown(&self, by: &[f32]) -> Tile {
+        if by.iter().all(|&g| g == 0.0) {
+            return self.clone();
+        }
+        let layers: Vec<TileLayer> = self
+            .layers
+            .iter()
+            .zip(by.iter().chain(std::iter::repeat(&0.0)))
+            .map(|(l, &g)| TileLayer {
+                color: l.color,
+                sdf: l.sdf.map(|d| d - g),
+            })
+            .collect();
+        let colour = composite(&layers, self.paper, self.width(), self.height());
+        Tile {
+            layers,
+            colour,
+            ..self.clone()
+        }
+    }
+
     /// Width, pixels.
     pub fn width(&self) -> usize {
         self.colour.width()

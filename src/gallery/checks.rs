@@ -5,7 +5,12 @@
 //!   outside the region beyond the tracing tolerance; forks of the top
 //!   layer's bands and the regularity of its gaps within 20 % of the
 //!   swatch's own (`fill::continuity`); the finest level's synthesis energy
-//!   below its initialization's.
+//!   below its initialization's. The swatches' own figures are pooled over
+//!   all of a style's swatches: a seamless tile measured on its 3 × 3
+//!   repetition's centre copy, any other swatch on itself more than 6 px
+//!   inside its shape (a motif on paper) or its border; ink as a share of
+//!   the pattern (a motif's shape, not the paper round it). Gap regularity
+//!   is left out for a region too narrow to hold a whole gap.
 //! - pattern (stroke-pattern-synthesis.txt §3): elements placed, their
 //!   nearest-neighbour spacing within 20 % of the example's.
 //! - brush (decobrush.txt §5–7): ink covers 95 % of the path within half
@@ -333,7 +338,8 @@ fn worst(values: impl Iterator<Item = f64>, higher_is_better: bool, none: f64) -
 
 /// Forks of the top layer's bands per 10⁴ px and the share of regular
 /// gaps of the bottom layer, where `counted` (the tile's centre copy, or
-/// the region's inside more than 6 px from its outline).
+/// the region's inside more than 6 px from its outline); no share when no
+/// gap lies wholly where counted.
 fn continuity(
     bottom: &Grid<bool>,
     top: &Grid<bool>,
@@ -343,7 +349,10 @@ fn continuity(
     let area = counted.data().iter().filter(|&&c| c).count().max(1) as f64;
     let forks = junctions(top, counted, 4) as f64 * 1e4 / area;
     let paper = Grid::from_fn(bottom.width(), bottom.height(), |x, y| !bottom.get(x, y));
-    let gaps = (gap > 0.0).then(|| regular_gaps(&paper, counted, gap, 1.6));
+    // A region too narrow to hold a whole gap says nothing of their
+    // regularity.
+    let whole = pieces(&paper, counted).iter().any(|p| p.within);
+    let gaps = (gap > 0.0 && whole).then(|| regular_gaps(&paper, counted, gap, 1.6));
     (forks, gaps)
 }
 
