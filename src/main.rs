@@ -41,7 +41,7 @@ enum Command {
     Trace(TraceArgs),
     /// Arrange hand-drawn stroke elements along open paths and inside filled shapes.
     Pattern(PatternArgs),
-    /// Fill closed shapes with an art pattern synthesized from a tile.
+    /// Fill closed shapes with an art pattern synthesized from a style's swatches.
     Fill(FillArgs),
     /// Grow structured ornament of a brush style along open paths (DecoBrush).
     Brush(BrushArgs),
@@ -136,9 +136,14 @@ struct FillArgs {
     /// Draw the pattern this many times larger (multiplies the style's scale), 0.01..=100.
     #[arg(long, default_value_t = 1.0, value_name = "F")]
     scale: f64,
-    /// Tile raster size in pixels (longest side), overriding the style's.
+    /// Swatch raster size in pixels (longest side), overriding the style's.
     #[arg(long, value_name = "PX")]
     resolution: Option<u32>,
+    /// Synthesize every shape from this one swatch of the style (a file
+    /// that style.toml lists) instead of from all of them; a shape's
+    /// data-exemplar="FILE" pins its own.
+    #[arg(long, value_name = "FILE")]
+    exemplar: Option<String>,
 }
 
 #[derive(Args)]
@@ -523,6 +528,7 @@ fn run_fill(args: FillArgs, quiet: bool, verbose: bool) -> Result<(), Failure> {
         seed: args.out.seed,
         direction,
         scale: args.scale,
+        exemplar: args.exemplar.clone(),
         ..FillOptions::default()
     };
     opts.validate()?;

@@ -16,9 +16,12 @@
 //! the current image against the matches is recorded per level at its
 //! start and after each M-step, so its decrease can be checked.
 
+use super::atlas::Atlas;
 use super::levelset::{self, Evolution};
-use super::patchmatch::{Channels, Gather, Match, Nnf, Patch, Problem, ShapeTerm};
-use super::quilt::{self, QuiltOptions, Quilter};
+use super::patchmatch::{
+    patch_reach, Channels, Gather, Match, Nnf, Patch, Problem, ShapeTerm, Source,
+};
+use super::quilt::{block_reach, QuiltOptions, Quilter};
 use super::shape::{self, Histogram, ShapeHint};
 use super::tile::Tile;
 use crate::field::DirectionGrid;
@@ -104,41 +107,50 @@ pub fn synthesize_in(
     mask: Option<&Grid<bool>>,
     params: &EmParams,
 ) -> Synthesis {
-    Prepared::new(tile, params).synthesize(direction, mask, params.seed)
+    Prepared::new(std::slice::from_ref(tile), params).synthesize(direction, mask, params.seed)
 }
 
-/// The tile side of a synthesis, which depends on the tile and the
+/// The source side of a synthesis, which depends on the exemplars and the
 /// parameters but not on the target or the seed, so every region filled
-/// from one tile shares it: the tile pyramid (halved while
-/// [`represents_every_layer`]) and per level the weighted channels, the
-/// tile's direction angles (radians), its values interleaved for voting,
-/// its ink fractions, and per neighbourhood radius the rotated patch
-/// tables, the padded gather and (made when first asked) the Shape Hint
-/// descriptors of the tile's edge line.
+/// from one style shares it: the exemplar pyramid (halved while
+/// [`represents_every_layer`]) and per level the exemplars laid out on one
+/// atlas with their weighted channels, direction angles (radians) and
+/// values interleaved for voting, the pooled ink fractions, and per
+/// neighbourhood radius the rotated patch offsets, the allowed centres and
+/// (made when first asked) the Shape Hint descriptors of the exemplars'
+/// edges.
 #[derive(Clone, Debug)]
 pub struct Prepared {
     /// The parameters it was made for (the seed is given per synthesis).
     params: EmParams,
-    /// Pyramid levels, finest first.
+    /// Pyramid levels, finest first (of the thickened exemplars).
     levels: Vec<Level>,
+    /// Per layer, how far (finest px) its ink was grown for synthesis
+    /// ([`thickening`]); taken off the result.
+    grown: Vec<f32>,
+    /// Ink fraction of each layer of the finest exemplars as drawn.
+    ink: Vec<f64>,
 }
 
-/// One pyramid level of a [`Prepared`] tile.
+/// One pyramid level of a [`Prepared`] source.
 #[derive(Clone, Debug)]
 struct Level {
-    tile: Tile,
-    /// [`channels_of`] the tile.
-    source: Channels,
-    /// The tile's direction angles, radians.
-    source_angle: Grid<f32>,
-    /// Per tile pixel: each layer's SDF, then the colour.
+    /// The exemplars at this level, in style order.
+    tiles: Vec<Tile>,
+    /// Their atlas, channels and angles.
+    source: Source,
+    /// Per atlas pixel: each layer's SDF, then the colour.
     texels: Vec<f32>,
-    /// [`Tile::ink_fraction`] of each layer.
+    /// Number of SDF layers.
+    layers: usize,
+    /// Ink fraction of each layer over all exemplars' patterns.
     ink: Vec<f64>,
     /// Neighbourhood sizes in the order they run.
     scales: Vec<Scale>,
     /// Quilting tables (the coarsest level only).
     quilter: Option<Quilter>,
+    /// Quilting's block side, pixels.
+    block: usize,
 }
 
 /// One neighbourhood radius of a [`Level`].
@@ -147,101 +159,64 @@ struct Scale {
     radius: usize,
     patch: Patch,
     gather: Gather,
-    /// Shape Hint descriptors of every tile pixel (ring `r`, bins `r/2`);
-    /// `None` for a tile without an edge line.
-    hint: OnceLock<Option<Grid<Histogram>>>,
+    /// Allowed patch centres of the atlas for this radius.
+    centres: Vec<(u32, u32)>,
+    /// Shape Hint descriptors of every atlas pixel (ring `r`, bins `r/2`)
+    /// and whether they hold everywhere (a swatch's own edge); `None` when
+    /// no exemplar has an edge.
+    hint: OnceLock<Option<(Grid<Histogram>, bool)>>,
 }
 
 impl Prepared {
-    /// Prepares `tile` for synthesis with `params` (its seed is not used).
-    pub fn new(tile: &Tile, params: &EmParams) -> Prepared {
-        let mut tiles = vec![tile.clone()];
-        while tiles.len() < params.levels {
-            let t = tiles[tiles.len() - 1].half();
-            if !represents_every_layer(&t) {
+    /// Prepares `tiles` (one per exemplar, all with the same layers) for
+    /// synthesis with `params` (its seed is not used).
+    pub fn new(tiles: &[Tile], params: &EmParams) -> Prepared {
+        let layers = tiles.first().map_or(0, |t| t.layers.len());
+        let area: usize = tiles.iter().map(Tile::area).sum();
+        let ink = (0..layers)
+            .map(|l| tiles.iter().map(|t| t.ink_px(l)).sum::<usize>() as f64 / area.max(1) as f64)
+            .collect();
+        let grown = thickening(tiles);
+        let thick: Vec<Tile> = tiles.iter().map(|t| t.grown(&grown)).collect();
+        let mut pyramid = vec![thick];
+        while pyramid.len() < params.levels {
+            let half: Vec<Tile> = pyramid[pyramid.len() - 1].iter().map(Tile::half).collect();
+            let room = half
+                .iter()
+                .all(|t| t.periodic || t.width().min(t.height()) >= MIN_SWATCH_SIDE);
+            if !represents_every_layer(&half) || !room {
                 break;
             }
-            tiles.push(t);
+            pyramid.push(half);
         }
-        let n = tiles.len();
+        let n = pyramid.len();
         let clamp = clamp_of(params);
-        let levels = tiles
+        let levels = pyramid
             .into_iter()
             .enumerate()
-            .map(|(level, t)| {
-                let source_angle = t.direction.map(|d| d[1].atan2(d[0]));
-                let source = channels_of(
-                    &t.layers.iter().map(|l| l.sdf.clone()).collect::<Vec<_>>(),
-                    &t.colour,
-                    params.alpha,
-                    clamp,
-                );
-                // Neighbourhood sizes: at the coarsest level a larger one first.
-                let max_r = (t.width().min(t.height()) / 4).max(1);
-                let mut radii = vec![params.radius.min(max_r).max(1)];
-                if level + 1 == n && n > 1 && 2 * radii[0] <= max_r {
-                    radii.insert(0, 2 * radii[0]);
-                }
-                let scales: Vec<Scale> = radii
-                    .into_iter()
-                    .map(|r| {
-                        let patch = Patch::new(r);
-                        let gather = Gather::new(&source, &patch);
-                        Scale {
-                            radius: r,
-                            patch,
-                            gather,
-                            hint: OnceLock::new(),
-                        }
-                    })
-                    .collect();
-                // The tile's layer distances and colour interleaved per
-                // pixel: one cache line per vote instead of one per grid.
-                let stride = t.layers.len() + 3;
-                let mut texels = Vec::with_capacity(t.width() * t.height() * stride);
-                for y in 0..t.height() {
-                    for x in 0..t.width() {
-                        texels.extend(t.layers.iter().map(|l| l.sdf.get(x, y)));
-                        texels.extend(t.colour.get(x, y));
-                    }
-                }
-                let ink = (0..t.layers.len()).map(|l| t.ink_fraction(l)).collect();
-                let quilter =
-                    (level + 1 == n).then(|| Quilter::new(&source, quilt_block(&t, &scales)));
-                Level {
-                    tile: t,
-                    source,
-                    source_angle,
-                    texels,
-                    ink,
-                    scales,
-                    quilter,
-                }
-            })
+            .map(|(level, ts)| Level::new(ts, level, n, params, clamp))
             .collect();
         Prepared {
             params: *params,
             levels,
+            grown,
+            ink,
         }
     }
 
-    /// Fraction of the finest tile's pixels inside layer `m` (0 for a
-    /// layer it does not have).
+    /// Fraction of the finest exemplars' pattern pixels inside layer `m`
+    /// as drawn (0 for a layer they do not have).
     pub fn tile_ink(&self, m: usize) -> f64 {
-        self.levels
-            .first()
-            .and_then(|l| l.ink.get(m))
-            .copied()
-            .unwrap_or(0.0)
+        self.ink.get(m).copied().unwrap_or(0.0)
     }
 
-    /// Synthesizes an image from this tile and parameters whose texture
-    /// follows `direction` (a unit vector per target pixel), searching and
-    /// voting only the neighbourhoods that reach `mask` (the region, same
-    /// size as `direction`; pixels no neighbourhood reaches keep their
-    /// initial values, and energies count only those neighbourhoods), with
-    /// `seed` as the seed of every random choice: the same result, bit for
-    /// bit, whichever regions were filled before.
+    /// Synthesizes an image from these exemplars and parameters whose
+    /// texture follows `direction` (a unit vector per target pixel),
+    /// searching and voting only the neighbourhoods that reach `mask` (the
+    /// region, same size as `direction`; pixels no neighbourhood reaches
+    /// keep their initial values, and energies count only those
+    /// neighbourhoods), with `seed` as the seed of every random choice:
+    /// the same result, bit for bit, whichever regions were filled before.
     pub fn synthesize(
         &self,
         direction: &DirectionGrid,
@@ -252,15 +227,230 @@ impl Prepared {
             seed,
             ..self.params
         };
-        synthesize_levels(&self.levels, direction, mask, &params)
+        let mut s = synthesize_levels(&self.levels, direction, mask, &params);
+        for (l, &g) in s.layers.iter_mut().zip(&self.grown) {
+            if g > 0.0 {
+                for v in l.data_mut() {
+                    *v += g;
+                }
+            }
+        }
+        s
     }
 }
 
-/// Quilting's block side at the coarsest level, pixels: two patches of
-/// its first neighbourhood size, at most the tile.
-fn quilt_block(t: &Tile, scales: &[Scale]) -> usize {
-    let first_r = scales.first().map_or(1, |s| s.radius);
-    (4 * first_r + 2).min(t.width().min(t.height()))
+/// Half-width, finest pixels, below which a layer's ink is a line that is
+/// grown for synthesis.
+pub const LINE_DEPTH: f32 = 3.0;
+
+/// How far to grow each layer's ink for synthesis: a layer whose ink is
+/// nowhere deeper than [`LINE_DEPTH`] (lines up to 6 px wide) is grown
+/// towards that depth, but never so far that its ink gets deeper than the
+/// paper between it (a dense layer's narrow paper gaps would become the
+/// lines that averaging wipes out). Averaging the signed distances of
+/// neighbourhoods that disagree by a pixel or two wipes out a line one or
+/// two pixels wide but only shifts the edges of a wide one; a line grown
+/// by `g` and taken back by `g` after synthesis (both exact on a distance
+/// field) keeps its drawn width (DecoBrush §4.1 thickens lines the same
+/// way).
+pub fn thickening(tiles: &[Tile]) -> Vec<f32> {
+    let layers = tiles.first().map_or(0, |t| t.layers.len());
+    (0..layers)
+        .map(|l| {
+            let extreme = |sign: f32| {
+                tiles
+                    .iter()
+                    .map(|t| {
+                        t.layers[l]
+                            .sdf
+                            .data()
+                            .iter()
+                            .map(|&d| d * sign)
+                            .fold(0.0f32, f32::max)
+                    })
+                    .fold(0.0f32, f32::max)
+            };
+            let (depth, paper) = (extreme(-1.0), extreme(1.0));
+            if depth > 0.0 && depth < LINE_DEPTH {
+                (LINE_DEPTH - depth).min((paper - depth) / 2.0).max(0.0)
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
+
+impl Level {
+    /// Level `level` of `n` (0 finest) made of `tiles`.
+    fn new(tiles: Vec<Tile>, level: usize, n: usize, params: &EmParams, clamp: f32) -> Level {
+        // Neighbourhood sizes: at the coarsest level a larger one first. A
+        // patch of a swatch that is not periodic must fit inside it turned
+        // any way with room to move: its reach at most a quarter of the
+        // swatch's shorter side.
+        let side = |periodic: bool| {
+            tiles
+                .iter()
+                .filter(|t| periodic || !t.periodic)
+                .map(|t| t.width().min(t.height()))
+                .min()
+        };
+        let smallest = side(true).unwrap_or(1);
+        let room = side(false).map(|s| s / 4);
+        let fits = |reach: usize| room.is_none_or(|q| reach <= q);
+        let mut max_r = (smallest / 4).max(1);
+        while max_r > 1 && !fits(patch_reach(max_r)) {
+            max_r -= 1;
+        }
+        let mut radii = vec![params.radius.min(max_r).max(1)];
+        if level + 1 == n && n > 1 && 2 * radii[0] <= max_r {
+            radii.insert(0, 2 * radii[0]);
+        }
+        let coarsest = level + 1 == n;
+        let mut block = (4 * radii[0] + 2).min(smallest);
+        while block > 2 && !fits(block_reach(block)) {
+            block -= 1;
+        }
+        let r_max = radii.iter().copied().max().unwrap_or(1);
+        // Enough margin for any turned patch, a Shape Hint's outer bins
+        // (ring r, bins r/2) and, at the coarsest level, a quilting block.
+        let mut margin = patch_reach(r_max).max(r_max + r_max.div_ceil(2) + 2);
+        if coarsest {
+            margin = margin.max(block_reach(block));
+        }
+        // A swatch's patch centres: its shape widened by the finest patch
+        // radius of the level (a patch reaching the shape is allowed).
+        let r_min = radii.iter().copied().min().unwrap_or(1) as f32;
+        let blocks = tiles
+            .iter()
+            .map(|t| {
+                let near = t.shape.as_ref().map(|s| {
+                    let d2 = crate::raster::edt::squared_edt(s);
+                    d2.map(|v| v <= r_min * r_min)
+                });
+                (t.width(), t.height(), t.periodic, near)
+            })
+            .collect();
+        let atlas = Atlas::new(blocks, margin);
+        // For every atlas pixel, the exemplar pixel it shows.
+        let shows: Vec<Grid<(u32, u32)>> = tiles
+            .iter()
+            .map(|t| Grid::from_fn(t.width(), t.height(), |x, y| (x as u32, y as u32)))
+            .collect();
+        let shows = atlas.pad(&shows.iter().collect::<Vec<_>>(), (0, 0));
+        let layers = tiles.first().map_or(0, |t| t.layers.len());
+        let tile_channels: Vec<Channels> = tiles
+            .iter()
+            .map(|t| {
+                channels_of(
+                    &t.layers.iter().map(|l| l.sdf.clone()).collect::<Vec<_>>(),
+                    &t.colour,
+                    params.alpha,
+                    clamp,
+                )
+            })
+            .collect();
+        let depth = layers + 3;
+        let mut data = Vec::with_capacity(atlas.width * atlas.height * depth);
+        let mut texels = Vec::with_capacity(atlas.width * atlas.height * depth);
+        let mut angle = Grid::new(atlas.width, atlas.height, 0.0f32);
+        for y in 0..atlas.height {
+            let b = atlas.block_of(y);
+            let t = &tiles[b];
+            for x in 0..atlas.width {
+                let (sx, sy) = shows.get(x, y);
+                let (sx, sy) = (sx as usize, sy as usize);
+                data.extend_from_slice(tile_channels[b].px(sx, sy));
+                // The tile's layer distances and colour interleaved per
+                // pixel: one cache line per vote instead of one per grid.
+                texels.extend(t.layers.iter().map(|l| l.sdf.get(sx, sy)));
+                texels.extend(t.colour.get(sx, sy));
+                let d = t.direction.get(sx, sy);
+                angle.set(x, y, d[1].atan2(d[0]));
+            }
+        }
+        let source = Source {
+            channels: Channels {
+                width: atlas.width,
+                height: atlas.height,
+                depth,
+                data,
+            },
+            angle,
+            atlas,
+        };
+        let scales: Vec<Scale> = radii
+            .into_iter()
+            .map(|r| {
+                let patch = Patch::new(r);
+                let gather = Gather::new(&source, &patch);
+                Scale {
+                    radius: r,
+                    centres: source.atlas.centres(patch_reach(r)),
+                    patch,
+                    gather,
+                    hint: OnceLock::new(),
+                }
+            })
+            .collect();
+        let area: usize = tiles.iter().map(Tile::area).sum();
+        let ink = (0..layers)
+            .map(|l| tiles.iter().map(|t| t.ink_px(l)).sum::<usize>() as f64 / area.max(1) as f64)
+            .collect();
+        let quilter = coarsest.then(|| Quilter::new(&source, block));
+        Level {
+            tiles,
+            source,
+            texels,
+            layers,
+            ink,
+            scales,
+            quilter,
+            block,
+        }
+    }
+
+    /// The Shape Hint descriptors of scale `sc` (ring `r`, bins `r/2`) of
+    /// every atlas pixel, from each exemplar's edge: a swatch's shape
+    /// outline (holding everywhere), else a tile's edge line; `None` when
+    /// no exemplar has one.
+    fn hints<'a>(&self, sc: &'a Scale) -> Option<&'a (Grid<Histogram>, bool)> {
+        sc.hint
+            .get_or_init(|| {
+                let edges: Vec<Option<Grid<bool>>> = self
+                    .tiles
+                    .iter()
+                    .map(|t| {
+                        t.shape_edge()
+                            .or_else(|| t.edge.map(|e| e.raster(t.width(), t.height())))
+                    })
+                    .collect();
+                if edges.iter().all(Option::is_none) {
+                    return None;
+                }
+                let everywhere = self.tiles.iter().any(|t| t.shape.is_some());
+                let grids: Vec<Grid<bool>> = edges
+                    .into_iter()
+                    .zip(&self.tiles)
+                    .map(|(e, t)| e.unwrap_or_else(|| Grid::new(t.width(), t.height(), false)))
+                    .collect();
+                let atlas = &self.source.atlas;
+                let edge = atlas.pad(&grids.iter().collect::<Vec<_>>(), false);
+                // A swatch's margin repeats its border, which is no edge.
+                let edge = Grid::from_fn(atlas.width, atlas.height, |x, y| {
+                    let (b, ex, ey) = atlas.block_pixel(x, y);
+                    let bl = &atlas.blocks[b];
+                    edge.get(x, y)
+                        && (bl.periodic
+                            || (ex >= 0 && ey >= 0 && ex < bl.w as i64 && ey < bl.h as i64))
+                });
+                let (ring, bin) = (sc.radius as f32, (sc.radius as f32 / 2.0).max(1.0));
+                Some((
+                    ShapeHint::new(&edge, false, ring, bin).histograms(&self.source.angle),
+                    everywhere,
+                ))
+            })
+            .as_ref()
+    }
 }
 
 /// The SDF clamp `K` of [`channels_of`], pixels.
@@ -278,11 +468,11 @@ fn synthesize_levels(
     let (width, height) = (direction.width(), direction.height());
     let levels = tiles.len();
     let mut state: Option<State> = None;
-    let mut nnf: Option<Nnf> = None;
+    // The field and the atlas it points into.
+    let mut nnf: Option<(Nnf, &Atlas)> = None;
     let mut energy = Vec::new();
     for level in (0..levels).rev() {
         let lv = &tiles[level];
-        let t = &lv.tile;
         let f = 1usize << level;
         let (w, h) = (width.div_ceil(f).max(1), height.div_ceil(f).max(1));
         let target_angle = Grid::from_fn(w, h, |x, y| {
@@ -292,7 +482,6 @@ fn synthesize_levels(
             );
             d[1].atan2(d[0])
         });
-        let source_angle = &lv.source_angle;
         // Squared distance to the region at this level (any pixel of a
         // block counts).
         let level_mask = mask.map(|m| {
@@ -305,54 +494,68 @@ fn synthesize_levels(
         let first_r = lv.scales.first().map_or(1, |s| s.radius);
         let clamp = clamp_of(params);
         let source = &lv.source;
+        let atlas = &source.atlas;
+        let stride = lv.layers + 3;
+        let texel = |x: u32, y: u32| {
+            let i = (y as usize * atlas.width + x as usize) * stride;
+            &lv.texels[i..i + stride]
+        };
         let mut st = match state.take() {
             None => {
-                let block = quilt_block(t, &lv.scales);
                 let qo = QuiltOptions {
-                    block,
-                    overlap: (block / 4).max(1),
+                    block: lv.block,
+                    overlap: (lv.block / 4).max(1),
                     candidates: 4096,
                     seed: params.seed,
                 };
                 let map = match &lv.quilter {
-                    Some(q) => q.quilt(source, source_angle, &target_angle, &qo),
-                    None => quilt::quilt(source, source_angle, &target_angle, &qo),
+                    Some(q) => q.quilt(source, &target_angle, &qo),
+                    None => Quilter::new(source, lv.block).quilt(source, &target_angle, &qo),
                 };
-                let phi = t
-                    .layers
-                    .iter()
+                let phi = (0..lv.layers)
                     .map(|l| {
                         Grid::from_fn(w, h, |x, y| {
                             let (sx, sy) = map.get(x, y);
-                            l.sdf.get(sx as usize, sy as usize)
+                            texel(sx, sy)[l]
                         })
                     })
                     .collect();
                 let colour = Grid::from_fn(w, h, |x, y| {
                     let (sx, sy) = map.get(x, y);
-                    t.colour.get(sx as usize, sy as usize)
+                    let t = texel(sx, sy);
+                    [t[lv.layers], t[lv.layers + 1], t[lv.layers + 2]]
                 });
                 let spacing = spacing_of(first_r);
                 let (cols, rows) = Nnf::shape(w, h, spacing);
+                let reach = patch_reach(first_r);
                 let matches = (0..cols * rows)
                     .map(|k| {
                         let (sx, sy) = map.get(
                             ((k % cols) * spacing).min(w - 1),
                             ((k / cols) * spacing).min(h - 1),
                         );
+                        let (x, y) = atlas.bring_in(
+                            atlas.block_of(sy as usize),
+                            sx as i64,
+                            sy as i64,
+                            reach,
+                        );
                         Match {
-                            x: sx,
-                            y: sy,
+                            x,
+                            y,
                             cost: f32::INFINITY,
                         }
                     })
                     .collect();
-                nnf = Some(Nnf {
-                    cols,
-                    rows,
-                    spacing,
-                    matches,
-                });
+                nnf = Some((
+                    Nnf {
+                        cols,
+                        rows,
+                        spacing,
+                        matches,
+                    },
+                    atlas,
+                ));
                 State { phi, colour }
             }
             Some(prev) => upsample(&prev, w, h),
@@ -362,7 +565,7 @@ fn synthesize_levels(
             let r = sc.radius;
             let patch = &sc.patch;
             let spacing = spacing_of(r);
-            let mut field = resample_nnf(nnf.take(), w, h, spacing, t);
+            let mut field = resample_nnf(nnf.take(), atlas, w, h, spacing, patch_reach(r));
             let n = if level == 0 && levels > 1 {
                 params.iterations.div_ceil(4)
             } else {
@@ -370,22 +573,21 @@ fn synthesize_levels(
             }
             .max(1);
             // Shape Hint descriptors (ring of radius r, bins r/2) of the
-            // tile's edge line and of the region's outline.
-            let hints = match (&level_mask, &t.edge) {
-                (Some(lm), Some(edge)) if params.shape > 0.0 => {
+            // exemplars' edges and of the region's outline.
+            let hints = match &level_mask {
+                Some(lm) if params.shape > 0.0 => lv.hints(sc).map(|(src, everywhere)| {
                     let (ring, bin) = (r as f32, (r as f32 / 2.0).max(1.0));
-                    let src = sc.hint.get_or_init(|| {
-                        Some(
-                            ShapeHint::new(&edge.raster(t.width(), t.height()), true, ring, bin)
-                                .histograms(source_angle),
-                        )
-                    });
                     let tgt = ShapeHint::new(&shape::outline(lm), false, ring, bin);
-                    src.as_ref().map(|src| (src, tgt.histograms(&target_angle)))
-                }
+                    (src, tgt.histograms(&target_angle), *everywhere)
+                }),
                 _ => None,
             };
-            let (mut lambda, mut mu) = (0.2f32, 0.8f32);
+            // Alg. 1's weights, λ from 0.2 and μ from 0.8 in steps of
+            // 0.75/N; a level run with fewer iterations (the finest, whose
+            // start is already close) takes the schedule's last ones.
+            let full = params.iterations.max(n);
+            let skipped = (full - n) as f32 * 0.75 / full as f32;
+            let (mut lambda, mut mu) = (0.2 + skipped, 0.8 - skipped);
             for it in 0..n {
                 let target = channels_of(&st.phi, &st.colour, params.alpha, clamp);
                 let reach = (r as f32 * std::f32::consts::SQRT_2 + 1.0).powi(2);
@@ -399,20 +601,21 @@ fn synthesize_levels(
                 });
                 let mut pb = Problem::with_gather(
                     source,
-                    source_angle,
                     &target,
                     &target_angle,
                     patch,
                     &sc.gather,
+                    &sc.centres,
                 );
                 if let Some(a) = &active {
                     pb = pb.with_active(a);
                 }
-                if let Some((src, tgt)) = &hints {
+                if let Some((src, tgt, everywhere)) = &hints {
                     pb = pb.with_shape(ShapeTerm {
                         source: src,
                         target: tgt,
                         weight: params.shape * ((2 * r + 1) * (2 * r + 1)) as f32,
+                        everywhere: *everywhere,
                     });
                 }
                 pb.refresh(&mut field);
@@ -442,11 +645,12 @@ fn synthesize_levels(
                 for (phi, (mean, count)) in st.phi.iter_mut().zip(&votes.sdf) {
                     levelset::evolve(phi, mean, count, &ev);
                 }
+
                 st.colour = votes.colour;
-                lambda += 0.75 / n as f32;
-                mu -= 0.75 / n as f32;
+                lambda += 0.75 / full as f32;
+                mu -= 0.75 / full as f32;
             }
-            nnf = Some(field);
+            nnf = Some((field, atlas));
         }
         energy.push(level_energy);
         state = Some(st);
@@ -462,19 +666,31 @@ fn synthesize_levels(
     }
 }
 
+/// Shortest side, pixels, of a swatch that is not periodic at any pyramid
+/// level: smaller, its patches would have no room to move in it.
+pub const MIN_SWATCH_SIDE: usize = 48;
+
 /// Least depth, pixels, that every layer's ink must reach somewhere in a
 /// pyramid level's tile: half a pixel, a stroke one pixel wide.
 pub const MIN_LEVEL_DEPTH: f32 = 0.5;
 
-/// Whether a (halved) tile still holds every layer: each layer's SDF
-/// reaches [`MIN_LEVEL_DEPTH`] inside. Strokes thinner than a pixel break
+/// Whether (halved) exemplars still hold every layer: each layer's SDF
+/// reaches [`MIN_LEVEL_DEPTH`] inside in one of them. Strokes thinner than a pixel break
 /// into dots or vanish at that level (the scales' 2.4-unit arcs in a 96 px
 /// tile at quarter resolution), and the coarsest level, which lays out the
 /// whole pattern (Alg. 1), would lay it out from debris.
-pub fn represents_every_layer(t: &Tile) -> bool {
-    t.layers.iter().all(|l| {
-        let deepest = l.sdf.data().iter().copied().fold(0.0f32, f32::min);
-        -deepest >= MIN_LEVEL_DEPTH
+pub fn represents_every_layer(tiles: &[Tile]) -> bool {
+    let layers = tiles.first().map_or(0, |t| t.layers.len());
+    (0..layers).all(|l| {
+        tiles.iter().any(|t| {
+            let deepest = t.layers[l]
+                .sdf
+                .data()
+                .iter()
+                .copied()
+                .fold(0.0f32, f32::min);
+            -deepest >= MIN_LEVEL_DEPTH
+        })
     })
 }
 
@@ -522,22 +738,33 @@ pub fn channels_of(phi: &[Grid<f32>], colour: &Grid<[f32; 3]>, alpha: f32, clamp
     }
 }
 
-/// The previous field brought to a new spacing or resolution: each new
-/// centre takes the match of the nearest old centre (scaled by 2 across a
-/// level, CaTS Alg. 2) shifted by the offset between them.
-fn resample_nnf(old: Option<Nnf>, w: usize, h: usize, spacing: usize, t: &Tile) -> Nnf {
+/// The previous field (with the atlas it points into) brought to a new
+/// spacing or resolution on `atlas`: each new centre takes the match of
+/// the nearest old centre (scaled by 2 across a level, CaTS Alg. 2)
+/// shifted by the offset between them, in the same exemplar, brought in
+/// for patches reaching `reach` px.
+fn resample_nnf(
+    old: Option<(Nnf, &Atlas)>,
+    atlas: &Atlas,
+    w: usize,
+    h: usize,
+    spacing: usize,
+    reach: usize,
+) -> Nnf {
     let (cols, rows) = Nnf::shape(w, h, spacing);
-    let (tw, th) = (t.width() as i64, t.height() as i64);
     let matches = match &old {
-        None => vec![
-            Match {
-                x: 0,
-                y: 0,
-                cost: f32::INFINITY
-            };
-            cols * rows
-        ],
-        Some(o) => {
+        None => {
+            let (x, y) = atlas.centres(reach)[0];
+            vec![
+                Match {
+                    x,
+                    y,
+                    cost: f32::INFINITY
+                };
+                cols * rows
+            ]
+        }
+        Some((o, from)) => {
             // Old target extent in pixels decides the scale factor.
             let old_w = (o.cols - 1) * o.spacing + 1;
             let scale = if old_w * 2 <= w + 2 * o.spacing { 2 } else { 1 };
@@ -550,9 +777,17 @@ fn resample_nnf(old: Option<Nnf>, w: usize, h: usize, spacing: usize, t: &Tile) 
                     let m = o.matches[j * o.cols + i];
                     let ox = qx as i64 - (i * o.spacing * scale) as i64;
                     let oy = qy as i64 - (j * o.spacing * scale) as i64;
+                    let (b, ex, ey) = from.block_pixel(m.x as usize, m.y as usize);
+                    let bl = &atlas.blocks[b];
+                    let (x, y) = atlas.bring_in(
+                        b,
+                        bl.x0 as i64 + ex * scale as i64 + ox,
+                        bl.y0 as i64 + ey * scale as i64 + oy,
+                        reach,
+                    );
                     Match {
-                        x: ((m.x as i64 * scale as i64 + ox).rem_euclid(tw)) as u32,
-                        y: ((m.y as i64 * scale as i64 + oy).rem_euclid(th)) as u32,
+                        x,
+                        y,
                         cost: f32::INFINITY,
                     }
                 })
@@ -660,7 +895,7 @@ fn coherence(pb: &Problem, nnf: &Nnf, k: usize) -> f32 {
     let r = pb.patch.radius;
     let (qx, qy) = nnf.centre(k);
     let m = nnf.matches[k];
-    let (tw, th) = (pb.source.width as i64, pb.source.height as i64);
+    let atlas = &pb.source.atlas;
     let (ci, cj) = (k % nnf.cols, k / nnf.cols);
     let reach = (r / nnf.spacing).max(1);
     // Neighbours lie within the patch: their rotated offsets are in the
@@ -681,11 +916,12 @@ fn coherence(pb: &Problem, nnf: &Nnf, k: usize) -> f32 {
             let Some(e) = table.get(((dy + r as i32) * side + dx + r as i32) as usize) else {
                 continue;
             };
-            // Torus distance between the two images of the neighbour.
-            let ex = (m.x as i64 + e.2 as i64 - o.x as i64).rem_euclid(tw);
-            let ey = (m.y as i64 + e.3 as i64 - o.y as i64).rem_euclid(th);
-            let (ex, ey) = (ex.min(tw - ex) as f32, ey.min(th - ey) as f32);
-            let d2 = ex * ex + ey * ey;
+            // Distance between the two images of the neighbour (on the
+            // torus within a tile, far across exemplars).
+            let d2 = atlas.d2(
+                (m.x as i64 + e.2 as i64, m.y as i64 + e.3 as i64),
+                (o.x as i64, o.y as i64),
+            );
             sum += COHERENCE_EXP
                 .get(d2 as usize)
                 .copied()
@@ -700,7 +936,6 @@ fn coherence(pb: &Problem, nnf: &Nnf, k: usize) -> f32 {
 /// overlapping matched neighbourhoods put there. Rows are gathered in
 /// parallel, each scanning the centres whose patches cross it.
 fn vote(pb: &Problem, nnf: &Nnf, lv: &Level, hist: &[[f32; 2]], w: usize, h: usize) -> Votes {
-    let t = &lv.tile;
     let per_centre: Vec<(f32, usize)> = (0..nnf.matches.len())
         .into_par_iter()
         .map(|k| {
@@ -715,17 +950,8 @@ fn vote(pb: &Problem, nnf: &Nnf, lv: &Level, hist: &[[f32; 2]], w: usize, h: usi
     let r = pb.patch.radius as i64;
     let s = nnf.spacing as i64;
     let side = 2 * r + 1;
-    let layers = t.layers.len();
-    let (tw, th) = (t.width() as i64, t.height() as i64);
-    let wrap = |v: i64, n: i64| {
-        if v < 0 {
-            v + n
-        } else if v >= n {
-            v - n
-        } else {
-            v
-        }
-    };
+    let layers = lv.layers;
+    let aw = lv.source.atlas.width as i64;
     let stride = layers + 3;
     let tv = &lv.texels;
     let rows: Vec<RowVote> = (0..h)
@@ -757,10 +983,11 @@ fn vote(pb: &Problem, nnf: &Nnf, lv: &Level, hist: &[[f32; 2]], w: usize, h: usi
                     let (x0, x1) = ((qx - r).max(0), (qx + r).min(w as i64 - 1));
                     for x in x0..=x1 {
                         let e = table[((dy + r) * side + x - qx + r) as usize];
-                        let sx = wrap(m.x as i64 + e.2 as i64, tw) as usize;
-                        let sy = wrap(m.y as i64 + e.3 as i64, th) as usize;
+                        // The atlas's margin holds a tile's wrap-around.
+                        let sx = m.x as i64 + e.2 as i64;
+                        let sy = m.y as i64 + e.3 as i64;
                         let xu = x as usize;
-                        let base = (sy * tw as usize + sx) * stride;
+                        let base = ((sy * aw + sx) as usize) * stride;
                         let Some(px) = tv.get(base..base + stride) else {
                             continue;
                         };

@@ -33,6 +33,7 @@
 //! Not done: the colour warp by the level-set deformation field (§2, last
 //! paragraph), replaced by voting.
 
+pub mod atlas;
 #[cfg(test)]
 pub mod continuity;
 pub mod em;
@@ -48,13 +49,13 @@ use crate::field::diffusion::constant_field;
 use crate::raster::{Grid, Sdf};
 use crate::read::sketch::{Query, QueryKind, Sketch};
 use crate::read::style::{self, DirectionToml, StyleKind};
-use crate::svg_out::{decimals_for, Document, FillRule, Group, Shape};
+use crate::svg_out::{decimals_for, Color, Document, FillRule, Group, Shape};
 use crate::trace::{trace_sdf, TraceOptions};
 use em::EmParams;
 use kurbo::{BezPath, PathEl, Point, Shape as _};
 use region::Region;
 use std::path::Path;
-use tile::{SourceDirection, Tile};
+use tile::{Palette, SourceDirection, Swatch, Tile};
 
 /// Options of [`crate::fill()`].
 #[derive(Clone, Debug)]
@@ -71,6 +72,11 @@ pub struct FillOptions {
     /// Multiplies the style's `scale`: the pattern drawn this many times
     /// larger in the sketch (0.01..=100; default 1).
     pub scale: f64,
+    /// Synthesize every region from this one swatch of its style (its
+    /// file name as `style.toml` lists it) instead of from all of them,
+    /// unless the region pins another with `data-exemplar` (default
+    /// `None`).
+    pub exemplar: Option<String>,
 }
 
 impl Default for FillOptions {
@@ -80,6 +86,7 @@ impl Default for FillOptions {
             direction: None,
             tolerance: 0.25,
             scale: 1.0,
+            exemplar: None,
         }
     }
 }
@@ -113,17 +120,37 @@ impl FillOptions {
     }
 }
 
-/// A loaded fill style.
+/// A loaded fill style: every swatch at synthesis resolution, with the
+/// parameters they are synthesized with.
 #[derive(Clone, Debug)]
 pub struct FillStyle {
-    /// The tile at synthesis resolution.
-    pub tile: Tile,
+    /// One tile per swatch, in `style.toml` order, all with the same
+    /// layers (the style's [`Palette`] without its ground).
+    pub tiles: Vec<Tile>,
+    /// The swatch files as `style.toml` lists them.
+    pub files: Vec<String>,
+    /// The colour that fills the whole region under the layers, for
+    /// swatches coloured edge to edge.
+    pub ground: Option<Color>,
     /// Synthesis parameters (seed set per region).
     pub params: EmParams,
-    /// Sketch units per tile user unit.
-    pub scale: f64,
-    /// What the tile's direction follows where no stroke combs the shape.
+    /// How large the pattern is drawn in the sketch.
+    pub size: Size,
+    /// What the swatches' direction follows where no stroke combs the shape.
     pub flow: Flow,
+    /// How the swatches were read, for `--verbose`.
+    pub notes: Vec<String>,
+}
+
+/// How large a fill style's pattern is drawn in a sketch.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Size {
+    /// `scale` sketch units per user unit of the first swatch.
+    Scale(f64),
+    /// Each swatch's longest side spans the style's own `resolution` px
+    /// (CSS px) of the sketch: this many sketch px per synthesis px (1
+    /// unless `--resolution` overrides the style's).
+    Auto(f64),
 }
 
 /// A fill style's uncombed target field (the style's `flow` key).
@@ -136,54 +163,102 @@ pub enum Flow {
 }
 
 impl FillStyle {
-    /// Loads the style in `dir` (`kind = "fill"`), its tile rasterized at
-    /// `resolution` px when given, else the style's (default 96).
+    /// Loads the style in `dir` (`kind = "fill"`), each swatch rasterized
+    /// at `resolution` px on its longest side when given, else at the
+    /// style's (default 96). Errors name the file at fault.
     pub fn load(dir: &Path, resolution: Option<u32>) -> Result<FillStyle> {
         let toml = style::load(dir)?;
         toml.expect_kind(dir, StyleKind::Fill)?;
-        let ex = toml.exemplar.first().ok_or_else(|| {
-            Error::invalid("exemplar: missing").in_file(dir.join(style::STYLE_FILE))
-        })?;
+        let own = toml.resolution.unwrap_or(96);
+        let res = resolution.unwrap_or(own);
         let source = match &toml.direction {
+            Some(DirectionToml::Named(_)) => SourceDirection::Etf,
             Some(DirectionToml::Vector(v)) => SourceDirection::Constant(*v),
-            _ => SourceDirection::Etf,
+            None => SourceDirection::Constant([1.0, 0.0]),
         };
-        let tile = Tile::load(
-            &dir.join(&ex.file),
-            resolution.or(toml.resolution).unwrap_or(96),
-            source,
-        )?;
+        let mut swatches = Vec::with_capacity(toml.exemplar.len());
+        let mut notes = Vec::new();
+        for ex in &toml.exemplar {
+            let path = dir.join(&ex.file);
+            let sw = Swatch::read(&path, res)?;
+            // A swatch that is one flat colour is a fault of that file.
+            Palette::of(std::slice::from_ref(&sw))
+                .map_err(|why| Error::invalid(why).in_file(&path))?;
+            notes.extend(sw.notes.iter().cloned());
+            swatches.push(sw);
+        }
+        let palette = Palette::of(&swatches)
+            .map_err(|why| Error::invalid(why).in_file(dir.join(style::STYLE_FILE)))?;
+        if let Some(n) = &palette.note {
+            notes.push(format!("style {}: {n}", dir.display()));
+        }
+        let tiles: Vec<Tile> = swatches
+            .iter()
+            .map(|sw| Tile::from_swatch(sw, &palette, source))
+            .collect();
+        let files = toml
+            .exemplar
+            .iter()
+            .map(|e| e.file.to_string_lossy().into_owned())
+            .collect();
         let flow = match toml.flow {
+            Some(DirectionToml::Named(_)) => Flow::Outline,
             Some(DirectionToml::Vector(v)) => Flow::Fixed(v),
-            _ => Flow::Outline,
+            None => Flow::Fixed([1.0, 0.0]),
         };
         let defaults = EmParams::default();
+        // A tile's edge line is a line along its direction, so it frames an
+        // outline only where the field runs along it: under a fixed flow
+        // it would pull bands across the outline and tear the pattern
+        // there. A swatch's own edge is compared in both frames and holds
+        // under any flow.
+        let swatch_edge = tiles.iter().any(|t| t.shape.is_some());
         let params = EmParams {
             alpha: toml.alpha.unwrap_or(0.25) as f32,
             radius: (toml.patch.unwrap_or(9) / 2) as usize,
             levels: toml.levels.unwrap_or(3) as usize,
             iterations: toml.iterations.unwrap_or(4) as usize,
-            // The Shape Hint takes the tile's edge to be a line along its
-            // direction, so it frames an outline only where the field runs
-            // along it: under a fixed flow it would pull bands across the
-            // outline and tear the pattern there.
             shape: match flow {
-                Flow::Outline => defaults.shape,
-                Flow::Fixed(_) => 0.0,
+                Flow::Fixed(_) if !swatch_edge => 0.0,
+                _ => defaults.shape,
             },
             ..defaults
         };
+        let size = match toml.scale {
+            Some(s) => Size::Scale(s),
+            None => Size::Auto(own as f64 / res as f64),
+        };
         Ok(FillStyle {
-            tile,
+            tiles,
+            files,
+            ground: palette.ground,
             params,
-            scale: toml.scale.unwrap_or(1.0),
+            size,
             flow,
+            notes,
         })
     }
 
-    /// Synthesis pixels per sketch unit.
-    pub fn px_per_unit(&self) -> f64 {
-        1.0 / (self.tile.units_per_px * self.scale)
+    /// Synthesis pixels per user unit of `sketch`.
+    pub fn px_per_unit(&self, sketch: &Sketch) -> f64 {
+        match self.size {
+            Size::Scale(s) => 1.0 / (self.tiles[0].units_per_px * s),
+            Size::Auto(sketch_px_per_px) => {
+                let css_per_unit = sketch.width / sketch.view_box.width().max(1e-12);
+                css_per_unit / sketch_px_per_px
+            }
+        }
+    }
+
+    /// The index of the swatch whose file is `name` (as `style.toml` lists
+    /// it, or its file name alone).
+    pub fn exemplar(&self, name: &str) -> Option<usize> {
+        self.files.iter().position(|f| {
+            f == name
+                || Path::new(f)
+                    .file_name()
+                    .is_some_and(|n| n.to_string_lossy() == name)
+        })
     }
 }
 
@@ -196,14 +271,25 @@ pub struct RegionFill {
     pub id: String,
     /// The region on its grid.
     pub region: Region,
-    /// Clipped layer SDFs (bottom first), region grid pixels.
+    /// Clipped layer SDFs (bottom first, the ground not among them),
+    /// region grid pixels.
     pub layers: Vec<Grid<f32>>,
     /// Layer colours.
-    pub colors: Vec<crate::svg_out::Color>,
+    pub colors: Vec<Color>,
+    /// The ground's colour: the region's own outline is drawn in it under
+    /// the layers.
+    pub ground: Option<Color>,
+    /// The region's outline, sketch units (what the ground draws).
+    pub outline: BezPath,
+    /// The outline's fill rule.
+    pub fill_rule: FillRule,
     /// Traced layers, sketch units.
     pub paths: Vec<Vec<BezPath>>,
-    /// Ink fraction of the tile's bottom layer (all ink).
+    /// Ink fraction of the swatches' bottom layer (all ink over the
+    /// paper or ground).
     pub tile_ink: f64,
+    /// The swatches it was synthesized from (indices into the style's).
+    pub exemplars: Vec<usize>,
     /// Eq. 6 energies per level (see [`em::Synthesis::energy`]).
     pub energy: Vec<Vec<f64>>,
 }
@@ -243,8 +329,9 @@ pub struct FillOutput {
 }
 
 impl FillOutput {
-    /// The output document: one `<g id=QUERY>` per region, layers bottom
-    /// first in the tile's colours.
+    /// The output document: one `<g id=QUERY>` per region, the ground (the
+    /// region's outline) first when the swatches have one, then the layers
+    /// bottom first in their colours.
     pub fn to_document(&self) -> Document {
         let mut doc = Document::new(self.width, self.height, self.decimals);
         doc.view_box = self.view_box;
@@ -253,6 +340,12 @@ impl FillOutput {
                 id: r.id.clone(),
                 shapes: Vec::new(),
             };
+            if let Some(c) = r.ground {
+                g.shapes.push(Shape {
+                    fill_rule: r.fill_rule,
+                    ..Shape::filled(r.outline.clone(), c)
+                });
+            }
             for (paths, &color) in r.paths.iter().zip(&r.colors) {
                 for p in paths {
                     g.shapes.push(Shape {
@@ -276,6 +369,36 @@ fn combing_strokes(sk: &Sketch) -> Vec<(Vec<Point>, f64)> {
             QueryKind::Region { .. } => None,
         })
         .collect()
+}
+
+/// The swatches a region is synthesized from: the one it pins with
+/// `data-exemplar`, else the one `--exemplar` pins, else all of them.
+fn exemplars_of(
+    sk: &Sketch,
+    q: &Query,
+    name: &str,
+    st: &FillStyle,
+    opts: &FillOptions,
+) -> Result<Vec<usize>> {
+    let own = sk.exemplars.get(&q.id);
+    let Some(pin) = own.or(opts.exemplar.as_ref()) else {
+        return Ok((0..st.tiles.len()).collect());
+    };
+    match st.exemplar(pin) {
+        Some(k) => Ok(vec![k]),
+        None => {
+            let how = if own.is_some() {
+                "data-exemplar"
+            } else {
+                "--exemplar"
+            };
+            Err(Error::invalid(format!(
+                "{how} \"{pin}\" is not a swatch of style {name} ({})",
+                st.files.join(", ")
+            ))
+            .in_part(&q.id))
+        }
+    }
 }
 
 /// Fills every region query of a parsed sketch, each with the style
@@ -303,26 +426,33 @@ pub fn fill_sketch<'s>(
         .as_ref()
         .map(combing_strokes)
         .unwrap_or_default();
-    // Each style's tile is prepared for synthesis once per sketch, then
-    // shared by every region that uses it.
-    let mut prepared_styles: Vec<(&FillStyle, em::Prepared)> = Vec::new();
+    // Each style's swatches (all, or the one a region pins) are prepared
+    // for synthesis once per sketch, then shared by every region that uses
+    // them.
+    let mut prepared_styles: Vec<(&FillStyle, Vec<usize>, em::Prepared)> = Vec::new();
     let mut out = Vec::new();
     let mut notes = Vec::new();
     let mut max_ppu = 1.0f64;
     for (qi, (q, outline, rule)) in regions.into_iter().enumerate() {
         let (name, st) = style_of(q)?;
+        let which = exemplars_of(sk, q, name, st, opts)?;
         let k = match prepared_styles
             .iter()
-            .position(|(s, _)| std::ptr::eq(*s, st))
+            .position(|(s, w, _)| std::ptr::eq(*s, st) && *w == which)
         {
             Some(k) => k,
             None => {
-                prepared_styles.push((st, em::Prepared::new(&st.tile, &st.params)));
+                if !prepared_styles.iter().any(|(s, _, _)| std::ptr::eq(*s, st)) {
+                    notes.extend(st.notes.iter().cloned());
+                }
+                let tiles: Vec<Tile> = which.iter().map(|&i| st.tiles[i].clone()).collect();
+                let prepared = em::Prepared::new(&tiles, &st.params);
+                prepared_styles.push((st, which.clone(), prepared));
                 prepared_styles.len() - 1
             }
         };
-        let prepared = &prepared_styles[k].1;
-        let ppu = st.px_per_unit();
+        let prepared = &prepared_styles[k].2;
+        let ppu = st.px_per_unit(sk);
         max_ppu = max_ppu.max(ppu);
         let margin = st.params.radius + 2;
         let mut region = Region::rasterize(&q.id, outline, rule, ppu, margin)?;
@@ -337,8 +467,13 @@ pub fn fill_sketch<'s>(
             .collect();
         region.comb_all(&combing);
         let combed = combing.len();
+        let from = if which.len() == st.tiles.len() {
+            format!("{} swatch(es)", which.len())
+        } else {
+            format!("swatch {}", st.files[which[0]])
+        };
         notes.push(format!(
-            "{}: style {name}, {}×{} px grid, {} px inside, {combed} combing stroke(s)",
+            "{}: style {name} ({from}), {}×{} px grid, {} px inside, {combed} combing stroke(s)",
             q.id,
             region.width(),
             region.height(),
@@ -377,8 +512,12 @@ pub fn fill_sketch<'s>(
             .collect();
         out.push(RegionFill {
             id: q.id.clone(),
-            colors: st.tile.layers.iter().map(|l| l.color).collect(),
+            colors: st.tiles[0].layers.iter().map(|l| l.color).collect(),
+            ground: st.ground,
+            outline: outline.clone(),
+            fill_rule: rule,
             tile_ink: prepared.tile_ink(0),
+            exemplars: which,
             region,
             layers,
             paths,

@@ -1,5 +1,7 @@
 //! Rotated-patch PatchMatch: for each target neighbourhood, the most similar
-//! neighbourhood of the (periodic) tile.
+//! neighbourhood of any of the style's exemplars (laid out on one
+//! [`Atlas`]: wrapping within a seamless tile, inside the shape of any
+//! other swatch).
 //!
 //! * **Distance** — the sum of squared differences over all channels of a
 //!   `(2r+1)²` patch (art-pattern-level-sets Eq. 6 when the channels are
@@ -9,7 +11,8 @@
 //!   quantized to [`ANGLE_BINS`] and the rotated offsets rounded to whole
 //!   pixels (tables built once), so a comparison is a plain gather.
 //! * **Search** (CaTS §4.1.2) — random search in windows halving from the
-//!   tile size around the current match, then propagation by jump flooding
+//!   exemplar's size around the current match plus one jump to any allowed
+//!   centre of any exemplar, then propagation by jump flooding
 //!   with steps {4, 2, 1} (neighbour `n`'s match `p_n` proposes
 //!   `p_n + R(β_n)(q − n)`, the rigid map of Brushables Fig. 8).
 //!
@@ -17,6 +20,7 @@
 //! order), and random numbers are hashes of (seed, pass, position), so the
 //! result does not depend on the number of threads.
 
+use super::atlas::Atlas;
 use super::shape::{self, Histogram};
 use crate::raster::Grid;
 use crate::rng;
@@ -156,18 +160,55 @@ pub fn angle_bin(beta: f32) -> usize {
     round(t).rem_euclid(ANGLE_BINS as i64) as usize
 }
 
-/// What a search compares: the periodic source and its direction angles,
-/// the target and its direction angles (radians, pixel axes).
-///
-/// The source is stored padded by its own wrap-around (a margin of
-/// `⌈r√2⌉ + 1` pixels), so a rotated patch is a gather at precomputed
-/// linear offsets with no per-pixel wrapping.
+/// A level's exemplars ready to be searched: their channels and direction
+/// angles laid out on the padded [`Atlas`] (see there), with the layout.
+#[derive(Clone, Debug)]
+pub struct Source {
+    /// Where each exemplar lies.
+    pub atlas: Atlas,
+    /// The weighted channels over the whole atlas (margins included).
+    pub channels: Channels,
+    /// Direction angles (radians, pixel axes) over the whole atlas.
+    pub angle: Grid<f32>,
+}
+
+impl Source {
+    /// One seamless tile as a source, padded by `margin` (for tests).
+    #[cfg(test)]
+    pub fn tile(channels: &Channels, angle: &Grid<f32>, margin: usize) -> Source {
+        let (w, h, d) = (channels.width, channels.height, channels.depth);
+        let atlas = Atlas::new(vec![(w, h, true, None)], margin);
+        let px = Grid::from_fn(w, h, |x, y| (x as u32, y as u32));
+        let at = atlas.pad(&[&px], (0, 0));
+        let mut data = Vec::with_capacity(atlas.width * atlas.height * d);
+        for &(x, y) in at.data() {
+            data.extend_from_slice(channels.px(x as usize, y as usize));
+        }
+        Source {
+            channels: Channels {
+                width: atlas.width,
+                height: atlas.height,
+                depth: d,
+                data,
+            },
+            angle: atlas.pad(&[angle], 0.0),
+            atlas,
+        }
+    }
+}
+
+/// The margin an atlas needs for patches of radius `r` turned by any
+/// angle: `⌈r√2⌉ + 1` pixels.
+pub fn patch_reach(r: usize) -> usize {
+    (r as f64 * std::f64::consts::SQRT_2).ceil() as usize + 1
+}
+
+/// What a search compares: the level's [`Source`] and the target with its
+/// direction angles (radians, pixel axes).
 #[derive(Clone, Debug)]
 pub struct Problem<'a> {
-    /// Tile channels (wrapping).
-    pub source: &'a Channels,
-    /// Tile direction angles.
-    pub source_angle: &'a Grid<f32>,
+    /// The exemplars.
+    pub source: &'a Source,
     /// Target channels (clamped at the border).
     pub target: &'a Channels,
     /// Target direction angles.
@@ -175,41 +216,30 @@ pub struct Problem<'a> {
     /// Patch geometry.
     pub patch: &'a Patch,
     gather: Cow<'a, Gather>,
+    /// Every allowed patch centre of the source (for the search's jumps
+    /// between exemplars).
+    centres: Cow<'a, [(u32, u32)]>,
     active: Option<&'a [bool]>,
     shape: Option<ShapeTerm<'a>>,
 }
 
-/// A tile's channels padded by their own wrap-around (a margin of
-/// `⌈r√2⌉ + 1` pixels) and, per angle bin, the linear offsets of a rotated
-/// patch into them: what a [`Problem`] gathers from. It depends only on the
-/// tile and the patch radius, so it can be built once and shared by every
-/// search against that tile ([`Problem::with_gather`]).
+/// The linear offsets of a rotated patch into an atlas's channels, per
+/// angle bin: what a [`Problem`] gathers with. It depends only on the
+/// atlas's width and depth and the patch radius, so it is built once and
+/// shared by every search against that source ([`Problem::with_gather`]).
 #[derive(Clone, Debug)]
 pub struct Gather {
-    /// Tile width, height and depth it was built for, pixels and channels.
-    dims: (usize, usize, usize),
+    /// Atlas width and depth it was built for, pixels and channels.
+    dims: (usize, usize),
     /// Patch radius it was built for, pixels.
     radius: usize,
-    padded: Vec<f32>,
-    padded_width: usize,
-    margin: usize,
     linear: Vec<Vec<isize>>,
 }
 
 impl Gather {
-    /// Pads `source` and builds the offsets of `patch`'s rotation tables.
-    pub fn new(source: &Channels, patch: &Patch) -> Gather {
-        let margin = (patch.radius as f64 * std::f64::consts::SQRT_2).ceil() as usize + 1;
-        let (w, h, d) = (source.width, source.height, source.depth);
-        let (pw, ph) = (w + 2 * margin, h + 2 * margin);
-        let mut padded = Vec::with_capacity(pw * ph * d);
-        for y in 0..ph {
-            let sy = (y + h * (margin / h + 1) - margin) % h;
-            for x in 0..pw {
-                let sx = (x + w * (margin / w + 1) - margin) % w;
-                padded.extend_from_slice(source.px(sx, sy));
-            }
-        }
+    /// The offsets of `patch`'s rotation tables into `source`.
+    pub fn new(source: &Source, patch: &Patch) -> Gather {
+        let (pw, d) = (source.channels.width, source.channels.depth);
         let linear = (0..ANGLE_BINS)
             .map(|b| {
                 patch
@@ -220,86 +250,97 @@ impl Gather {
             })
             .collect();
         Gather {
-            dims: (w, h, d),
+            dims: (pw, d),
             radius: patch.radius,
-            padded,
-            padded_width: pw,
-            margin,
             linear,
         }
     }
 
-    /// Whether this gather was built for a source of `source`'s size and
+    /// Whether this gather was built for a source of `source`'s width and
     /// depth and a patch of `patch`'s radius.
-    pub fn fits(&self, source: &Channels, patch: &Patch) -> bool {
-        self.dims == (source.width, source.height, source.depth) && self.radius == patch.radius
+    pub fn fits(&self, source: &Source, patch: &Patch) -> bool {
+        self.dims == (source.channels.width, source.channels.depth) && self.radius == patch.radius
     }
 }
 
 /// The Shape Hint term of a search (Brushables Eq. 6): `weight · χ²`
 /// between the source pixel's and the target centre's descriptors, each
 /// in its own direction frame (so the pair is compared rotated by Eq. 5's
-/// angle); left out where the target descriptor is empty.
+/// angle).
 #[derive(Clone, Copy, Debug)]
 pub struct ShapeTerm<'a> {
-    /// Descriptor of every tile pixel.
+    /// Descriptor of every source (atlas) pixel.
     pub source: &'a Grid<Histogram>,
     /// Descriptor of every target pixel.
     pub target: &'a Grid<Histogram>,
     /// Weight of χ² against the patch SSD.
     pub weight: f32,
+    /// Whether the term holds where the target sees no outline too (a
+    /// swatch's own edge: the interior is kept from copying it), or only
+    /// near the outline (a tile's edge line, which repeats across the
+    /// tile).
+    pub everywhere: bool,
 }
 
 impl<'a> Problem<'a> {
-    /// Sets up a search (pads the source, builds the gather offsets).
+    /// Sets up a search (builds the gather offsets and the centre list).
     #[cfg(test)]
     pub fn new(
-        source: &'a Channels,
-        source_angle: &'a Grid<f32>,
+        source: &'a Source,
         target: &'a Channels,
         target_angle: &'a Grid<f32>,
         patch: &'a Patch,
     ) -> Problem<'a> {
         let gather = Cow::Owned(Gather::new(source, patch));
-        Problem::with(source, source_angle, target, target_angle, patch, gather)
+        let centres = Cow::Owned(source.atlas.centres(patch_reach(patch.radius)));
+        Problem::with(source, target, target_angle, patch, gather, centres)
     }
 
-    /// `Problem::new` (built for tests) with the padded source and gather offsets built
-    /// beforehand by [`Gather::new`]`(source, patch)` (shared by every
-    /// search against one tile, e.g. all regions of a sketch). A `gather`
-    /// of another size or radius is not used: the problem builds its own.
+    /// `Problem::new` (built for tests) with the gather offsets built
+    /// beforehand by [`Gather::new`]`(source, patch)` and the source's
+    /// allowed centres for this patch ([`Atlas::centres`] at
+    /// [`patch_reach`]), both shared by every search against one source.
+    /// A `gather` of another size or radius is not used: the problem
+    /// builds its own.
     pub fn with_gather(
-        source: &'a Channels,
-        source_angle: &'a Grid<f32>,
+        source: &'a Source,
         target: &'a Channels,
         target_angle: &'a Grid<f32>,
         patch: &'a Patch,
         gather: &'a Gather,
+        centres: &'a [(u32, u32)],
     ) -> Problem<'a> {
         let gather = if gather.fits(source, patch) {
             Cow::Borrowed(gather)
         } else {
             Cow::Owned(Gather::new(source, patch))
         };
-        Problem::with(source, source_angle, target, target_angle, patch, gather)
-    }
-
-    /// The problem with its gather decided, no active mask, no shape term.
-    fn with(
-        source: &'a Channels,
-        source_angle: &'a Grid<f32>,
-        target: &'a Channels,
-        target_angle: &'a Grid<f32>,
-        patch: &'a Patch,
-        gather: Cow<'a, Gather>,
-    ) -> Problem<'a> {
-        Problem {
+        Problem::with(
             source,
-            source_angle,
             target,
             target_angle,
             patch,
             gather,
+            Cow::Borrowed(centres),
+        )
+    }
+
+    /// The problem with its gather decided, no active mask, no shape term.
+    fn with(
+        source: &'a Source,
+        target: &'a Channels,
+        target_angle: &'a Grid<f32>,
+        patch: &'a Patch,
+        gather: Cow<'a, Gather>,
+        centres: Cow<'a, [(u32, u32)]>,
+    ) -> Problem<'a> {
+        Problem {
+            source,
+            target,
+            target_angle,
+            patch,
+            gather,
+            centres,
             active: None,
             shape: None,
         }
@@ -311,14 +352,15 @@ impl<'a> Problem<'a> {
         self
     }
 
-    /// The Shape Hint cost of matching target `(qx, qy)` with tile pixel
-    /// `(px, py)` (0 without the term or away from the outline).
+    /// The Shape Hint cost of matching target `(qx, qy)` with source pixel
+    /// `(px, py)` (0 without the term, and away from the outline unless
+    /// the term holds everywhere).
     #[inline]
     pub fn shape_cost(&self, qx: usize, qy: usize, px: usize, py: usize) -> f32 {
         match &self.shape {
             Some(s) => {
                 let t = s.target.get(qx, qy);
-                if shape::is_empty(&t) {
+                if !s.everywhere && shape::is_empty(&t) {
                     0.0
                 } else {
                     s.weight * shape::chi2(&s.source.get(px, py), &t)
@@ -344,37 +386,33 @@ impl<'a> Problem<'a> {
         }
     }
 
-    /// The rotation bin between tile pixel `(px, py)` and target `(qx, qy)`.
+    /// The rotation bin between source pixel `(px, py)` and target `(qx, qy)`.
     #[inline]
     pub fn bin(&self, px: usize, py: usize, qx: usize, qy: usize) -> usize {
-        angle_bin(self.source_angle.get(px, py) - self.target_angle.get(qx, qy))
+        angle_bin(self.source.angle.get(px, py) - self.target_angle.get(qx, qy))
     }
 
-    /// The tile pixel that target pixel `(qx + dx, qy + dy)` maps to under
-    /// the match `(px, py)` of centre `(qx, qy)`.
+    /// The source position (atlas pixels, not yet brought into its
+    /// exemplar) that target pixel `(qx + dx, qy + dy)` maps to under the
+    /// match `(px, py)` of centre `(qx, qy)`.
     #[inline]
-    pub fn map(
-        &self,
-        qx: usize,
-        qy: usize,
-        px: usize,
-        py: usize,
-        dx: i32,
-        dy: i32,
-    ) -> (usize, usize) {
+    pub fn map(&self, qx: usize, qy: usize, px: usize, py: usize, dx: i32, dy: i32) -> (i64, i64) {
         let (s, c) = self.patch.sin_cos[self.bin(px, py, qx, qy)];
         let (fx, fy) = (dx as f32, dy as f32);
         let rx = round(c * fx - s * fy);
         let ry = round(s * fx + c * fy);
-        self.wrap(px as i64 + rx, py as i64 + ry)
+        (px as i64 + rx, py as i64 + ry)
     }
 
+    /// Atlas position `(x, y)` proposed from the match `from` as a patch
+    /// centre of `from`'s exemplar (wrapped in a tile, clamped inside a
+    /// swatch), or `None` when the swatch's shape does not allow it.
     #[inline]
-    fn wrap(&self, x: i64, y: i64) -> (usize, usize) {
-        (
-            x.rem_euclid(self.source.width as i64) as usize,
-            y.rem_euclid(self.source.height as i64) as usize,
-        )
+    fn bring(&self, from: (u32, u32), x: i64, y: i64) -> Option<(usize, usize)> {
+        let atlas = &self.source.atlas;
+        let b = atlas.block_of(from.1 as usize);
+        let (px, py) = atlas.bring_in(b, x, y, patch_reach(self.patch.radius));
+        atlas.allowed(px, py).then_some((px as usize, py as usize))
     }
 
     /// Gathers the target patch at `(qx, qy)` (clamped at the border).
@@ -400,9 +438,9 @@ impl<'a> Problem<'a> {
         }
     }
 
-    /// Distance between the gathered target patch of `(qx, qy)` and tile
-    /// pixel `(px, py)`, plus the Shape Hint cost; stops early once over
-    /// `bound`.
+    /// Distance between the gathered target patch of `(qx, qy)` and source
+    /// pixel `(px, py)` (an allowed centre), plus the Shape Hint cost;
+    /// stops early once over `bound`.
     pub fn distance(
         &self,
         tp: &[f32],
@@ -412,17 +450,17 @@ impl<'a> Problem<'a> {
         py: usize,
         bound: f32,
     ) -> f32 {
-        let d = self.source.depth;
-        let g = &*self.gather;
-        let offsets = &g.linear[self.bin(px, py, qx, qy)];
-        let base = (((py + g.margin) * g.padded_width + px + g.margin) * d) as isize;
+        let src = &self.source.channels;
+        let d = src.depth;
+        let offsets = &self.gather.linear[self.bin(px, py, qx, qy)];
+        let base = ((py * src.width + px) * d) as isize;
         let mut sum = self.shape_cost(qx, qy, px, py);
         if sum > bound {
             return sum;
         }
         for (t, &off) in tp.chunks_exact(d).zip(offsets) {
             let i = (base + off) as usize;
-            let sp = &g.padded[i..i + d];
+            let sp = &src.data[i..i + d];
             for c in 0..d {
                 let e = sp[c] - t[c];
                 sum += e * e;
@@ -466,7 +504,7 @@ impl<'a> Problem<'a> {
             .collect()
     }
 
-    /// Replaces `best` by tile pixel `(px, py)` when that patch is closer
+    /// Replaces `best` by source pixel `(px, py)` when that patch is closer
     /// to the gathered target patch `tp` centred at `(qx, qy)`.
     fn try_candidate(
         &self,
@@ -488,19 +526,26 @@ impl<'a> Problem<'a> {
     /// One PatchMatch round: random search, then jump-flooding propagation.
     /// Costs must be current (see [`Problem::refresh`]).
     pub fn improve(&self, nnf: &mut Nnf, seed: u64, round: u64) {
-        let (sw, sh) = (self.source.width, self.source.height);
-        // Random search (CaTS Alg. 5, windows halving from the tile size).
+        let atlas = &self.source.atlas;
+        // Random search (CaTS Alg. 5, windows halving from the exemplar's
+        // size), and one jump to any allowed centre of any exemplar, so
+        // the energy can move a neighbourhood to another exemplar.
         nnf.matches = self.each_active(nnf, &nnf.matches, |buf, k, q, mut best| {
             self.target_patch(q.0, q.1, buf);
-            let mut radius = sw.max(sh) as i64 / 2;
+            let (cx, cy) = Atlas::pick(&self.centres, &[seed, round, k as u64, 0x7A3F]);
+            self.try_candidate(buf, q, (cx as usize, cy as usize), &mut best);
+            let bl = &atlas.blocks[atlas.block_of(best.y as usize)];
+            let mut radius = bl.w.max(bl.h) as i64 / 2;
             let mut i = 0u64;
             while radius >= 1 {
                 let span = 2 * radius as usize + 1;
                 let draw =
                     |axis| rng::index(&[seed, round, k as u64, i, axis], span) as i64 - radius;
                 let (ox, oy) = (draw(0), draw(1));
-                let p = self.wrap(best.x as i64 + ox, best.y as i64 + oy);
-                self.try_candidate(buf, q, p, &mut best);
+                let from = (best.x, best.y);
+                if let Some(p) = self.bring(from, best.x as i64 + ox, best.y as i64 + oy) {
+                    self.try_candidate(buf, q, p, &mut best);
+                }
                 radius /= 2;
                 i += 1;
             }
@@ -525,7 +570,10 @@ impl<'a> Problem<'a> {
                     let (nx, ny) = (ni * nnf.spacing, nj * nnf.spacing);
                     let dx = q.0 as i32 - nx as i32;
                     let dy = q.1 as i32 - ny as i32;
-                    let p = self.map(nx, ny, n.x as usize, n.y as usize, dx, dy);
+                    let (mx, my) = self.map(nx, ny, n.x as usize, n.y as usize, dx, dy);
+                    let Some(p) = self.bring((n.x, n.y), mx, my) else {
+                        continue;
+                    };
                     if p == (best.x as usize, best.y as usize) {
                         continue;
                     }
@@ -540,8 +588,8 @@ impl<'a> Problem<'a> {
         }
     }
 
-    /// The exact nearest tile pixel of centre `(qx, qy)` by exhaustive
-    /// search (first minimum in row-major order): the reference for tests.
+    /// The exact nearest allowed source centre of `(qx, qy)` by exhaustive
+    /// search (first minimum in centre order): the reference for tests.
     #[cfg(test)]
     pub fn brute_force(&self, qx: usize, qy: usize) -> Match {
         let mut buf = Vec::new();
@@ -551,30 +599,27 @@ impl<'a> Problem<'a> {
             y: 0,
             cost: f32::INFINITY,
         };
-        for py in 0..self.source.height {
-            for px in 0..self.source.width {
-                self.try_candidate(&buf, (qx, qy), (px, py), &mut best);
-            }
+        for &(px, py) in self.centres.iter() {
+            self.try_candidate(&buf, (qx, qy), (px as usize, py as usize), &mut best);
         }
         best
     }
 }
 
-/// A field of matches seeded at random (hash of seed and centre).
+/// A field of matches seeded at random among the allowed centres of
+/// `source` (hash of seed and centre).
 #[cfg(test)]
-pub fn random_nnf(
-    width: usize,
-    height: usize,
-    spacing: usize,
-    source: &Channels,
-    seed: u64,
-) -> Nnf {
+pub fn random_nnf(width: usize, height: usize, spacing: usize, source: &Source, seed: u64) -> Nnf {
     let (cols, rows) = Nnf::shape(width, height, spacing);
+    let centres = source.atlas.centres(source.atlas.margin);
     let matches = (0..cols * rows)
-        .map(|k| Match {
-            x: rng::index(&[seed, 0x5EED, k as u64, 0], source.width) as u32,
-            y: rng::index(&[seed, 0x5EED, k as u64, 1], source.height) as u32,
-            cost: f32::INFINITY,
+        .map(|k| {
+            let (x, y) = Atlas::pick(&centres, &[seed, 0x5EED, k as u64]);
+            Match {
+                x,
+                y,
+                cost: f32::INFINITY,
+            }
         })
         .collect();
     Nnf {
@@ -621,8 +666,10 @@ mod tests {
         let zero_s = Grid::new(32, 32, 0.0);
         let zero_t = Grid::new(w, h, 0.0);
         let patch = Patch::new(3);
-        let pb = Problem::new(&src, &zero_s, &tgt, &zero_t, &patch);
-        let mut nnf = random_nnf(w, h, 2, &src, 7);
+        let margin = patch_reach(3);
+        let source = Source::tile(&src, &zero_s, margin);
+        let pb = Problem::new(&source, &tgt, &zero_t, &patch);
+        let mut nnf = random_nnf(w, h, 2, &source, 7);
         pb.refresh(&mut nnf);
         for round in 0..6 {
             pb.improve(&mut nnf, 7, round);
@@ -638,7 +685,10 @@ mod tests {
             let bf = pb.brute_force(qx, qy);
             assert_eq!(
                 (bf.x, bf.y),
-                (((qx + 5) % 32) as u32, ((qy + 9) % 32) as u32)
+                (
+                    ((qx + 5) % 32 + margin) as u32,
+                    ((qy + 9) % 32 + margin) as u32
+                )
             );
             assert_eq!(bf.cost, 0.0);
             if (m.x, m.y) == (bf.x, bf.y) {
@@ -690,8 +740,10 @@ mod tests {
         let sa = Grid::new(24, 24, 0.0);
         let ta = Grid::new(w, h, -std::f32::consts::FRAC_PI_2);
         let patch = Patch::new(2);
-        let pb = Problem::new(&src, &sa, &tgt, &ta, &patch);
+        let m = patch_reach(2) as u32;
+        let source = Source::tile(&src, &sa, m as usize);
+        let pb = Problem::new(&source, &tgt, &ta, &patch);
         let bf = pb.brute_force(10, 10);
-        assert_eq!((bf.x, bf.y, bf.cost), (7, 4, 0.0));
+        assert_eq!((bf.x, bf.y, bf.cost), (7 + m, 4 + m, 0.0));
     }
 }

@@ -1,15 +1,18 @@
 //! Initialization by image quilting (Efros & Freeman 2001), with the SDF
 //! channels padded to every patch (art-pattern-level-sets §2).
 //!
-//! Blocks of `B×B` tile pixels are laid in raster order with an overlap of
-//! `O` pixels. Each block is the best of a set of seeded candidate tile
-//! positions by the SSD over the overlap (all channels, colour and SDF),
+//! Blocks of `B×B` source pixels are laid in raster order with an overlap
+//! of `O` pixels. Each block is the best of a set of seeded candidate
+//! positions in any exemplar by the SSD over the overlap (all channels, colour and SDF),
 //! chosen at random among those within 10 % of the best; the seam through
 //! the overlap is the minimum-error boundary cut, found by dynamic
 //! programming over the squared differences (a path from one side to the
 //! other, moving at most one pixel sideways per row).
 
-use super::patchmatch::{angle_bin, Channels, ANGLE_BINS};
+use super::atlas::Atlas;
+#[cfg(test)]
+use super::patchmatch::Channels;
+use super::patchmatch::{angle_bin, Source, ANGLE_BINS};
 use crate::raster::Grid;
 use crate::rng;
 use rayon::prelude::*;
@@ -21,45 +24,55 @@ pub struct QuiltOptions {
     pub block: usize,
     /// Overlap `O` (< `B`).
     pub overlap: usize,
-    /// Candidate positions tried per block; a tile with at most this many
-    /// pixels is searched exhaustively.
+    /// Candidate positions tried per block; a source with at most this
+    /// many allowed block centres is searched exhaustively.
     pub candidates: usize,
     /// Seed of the candidate positions and choices.
     pub seed: u64,
 }
 
-/// For every target pixel, the tile pixel it was copied from.
+/// For every target pixel, the source (atlas) pixel it was copied from.
 ///
 /// Blocks are copied turned by the direction difference `β = θ_s − θ_t`
-/// (tile angle at the candidate, target angle at the block's centre), as
+/// (source angle at the candidate, target angle at the block's centre), as
 /// the M-step's patches are, so the initial image already follows the
-/// target direction (pass zero angle grids for a plain quilt).
-pub fn quilt(
-    source: &Channels,
-    source_angle: &Grid<f32>,
-    target_angle: &Grid<f32>,
-    o: &QuiltOptions,
-) -> Grid<(u32, u32)> {
-    Quilter::new(source, o.block).quilt(source, source_angle, target_angle, o)
+/// target direction (pass zero angle grids for a plain quilt). Candidate
+/// block centres are the source's allowed centres for the block's reach
+/// ([`block_reach`]); the atlas's margin must be at least that reach.
+#[cfg(test)]
+pub fn quilt(source: &Source, target_angle: &Grid<f32>, o: &QuiltOptions) -> Grid<(u32, u32)> {
+    Quilter::new(source, o.block).quilt(source, target_angle, o)
 }
 
-/// What quilting from one tile with one block size needs whatever the
-/// target: the block offsets turned by each quantized angle and the tile
-/// padded by its own wrap-around. Made once, it serves every region
-/// filled from that tile ([`Quilter::quilt`]).
+/// How far a block of side `block` turned by any angle reaches from its
+/// centre, pixels.
+pub fn block_reach(block: usize) -> usize {
+    ((block.max(2) / 2) as f64 * std::f64::consts::SQRT_2).ceil() as usize + 1
+}
+
+/// What quilting from one source with one block size needs whatever the
+/// target: the block offsets turned by each quantized angle, as offsets
+/// into the source's atlas, and the allowed block centres. Made once, it
+/// serves every region filled from that source ([`Quilter::quilt`]).
 #[derive(Clone, Debug)]
 pub struct Quilter {
     /// Block side `B`, pixels (at least 2).
     block: usize,
     /// Per angle bin, per block offset (row-major): the turned offset, px.
     tables: Vec<Vec<(i64, i64)>>,
-    /// The tile, padded.
-    padded: Padded,
+    /// Per angle bin, per block offset: the channel index offset.
+    linear: Vec<Vec<isize>>,
+    /// The atlas width and depth the offsets are for.
+    dims: (usize, usize),
+    /// Allowed block centres.
+    centres: Vec<(u32, u32)>,
+    /// How far a turned block reaches from its centre, pixels.
+    reach: usize,
 }
 
 impl Quilter {
     /// Prepares quilting from `source` with blocks of `block` px a side.
-    pub fn new(source: &Channels, block: usize) -> Quilter {
+    pub fn new(source: &Source, block: usize) -> Quilter {
         let b = block.max(2);
         let tables: Vec<Vec<(i64, i64)>> = (0..ANGLE_BINS)
             .map(|k| {
@@ -79,61 +92,68 @@ impl Quilter {
                     .collect()
             })
             .collect();
-        let padded = Padded::new(source, &tables);
+        let (pw, d) = (source.channels.width, source.channels.depth);
+        let linear = tables
+            .iter()
+            .map(|t| {
+                t.iter()
+                    .map(|&(rx, ry)| (ry as isize * pw as isize + rx as isize) * d as isize)
+                    .collect()
+            })
+            .collect();
         Quilter {
             block: b,
             tables,
-            padded,
+            linear,
+            dims: (pw, d),
+            centres: source.atlas.centres(block_reach(b)),
+            reach: block_reach(b),
         }
     }
 
     /// [`quilt`] with these tables: the same map. `source` must be the
-    /// tile this was made for; when `o.block` or the tile's size differs
-    /// from what it was made for, a matching one is made first.
+    /// source this was made for; when `o.block` or the atlas differs from
+    /// what it was made for, a matching one is made first.
     pub fn quilt(
         &self,
-        source: &Channels,
-        source_angle: &Grid<f32>,
+        source: &Source,
         target_angle: &Grid<f32>,
         o: &QuiltOptions,
     ) -> Grid<(u32, u32)> {
         let fits = self.block == o.block.max(2)
-            && self.padded.dims == (source.width, source.height, source.depth);
+            && self.dims == (source.channels.width, source.channels.depth);
         if !fits {
-            return Quilter::new(source, o.block).quilt(source, source_angle, target_angle, o);
+            return Quilter::new(source, o.block).quilt(source, target_angle, o);
         }
-        quilt_blocks(self, source, source_angle, target_angle, o)
+        quilt_blocks(self, source, target_angle, o)
     }
 }
 
 /// The quilting loop of [`quilt`].
 fn quilt_blocks(
     q: &Quilter,
-    source: &Channels,
-    source_angle: &Grid<f32>,
+    source: &Source,
     target_angle: &Grid<f32>,
     o: &QuiltOptions,
 ) -> Grid<(u32, u32)> {
     let (width, height) = (target_angle.width(), target_angle.height());
-    let (sw, sh, d) = (source.width, source.height, source.depth);
+    let ch = &source.channels;
+    let d = ch.depth;
+    let atlas = &source.atlas;
     let b = q.block;
     let ov = o.overlap.min(b - 1);
     let step = b - ov;
     let mut map = Grid::new(width, height, (0u32, 0u32));
     let mut filled = Grid::new(width, height, false);
     let tables = &q.tables;
-    let padded = &q.padded;
-    // Tile pixel for block offset (x, y) of a block centred on tile (sx, sy).
+    // Source pixel for block offset (x, y) of a block centred on source
+    // (sx, sy): wrapped within a tile, within a swatch as it is.
     let rot = |sx: usize, sy: usize, x: usize, y: usize, bin: usize| -> (usize, usize) {
         let (rx, ry) = tables[bin][y * b + x];
-        (
-            (sx as i64 + rx).rem_euclid(sw as i64) as usize,
-            (sy as i64 + ry).rem_euclid(sh as i64) as usize,
-        )
+        let k = atlas.block_of(sy);
+        let (px, py) = atlas.bring_in(k, sx as i64 + rx, sy as i64 + ry, 0);
+        (px as usize, py as usize)
     };
-    // The candidates' overlap errors read the source through a copy padded
-    // by its own wrap-around, at per-bin linear offsets: no wrapping per
-    // pixel.
     let mut by = 0;
     let mut bi = 0u64;
     while by < height {
@@ -142,7 +162,7 @@ fn quilt_blocks(
             let bw = b.min(width - bx);
             let bh = b.min(height - by);
             let ta = target_angle.get((bx + b / 2).min(width - 1), (by + b / 2).min(height - 1));
-            let beta = |sx: usize, sy: usize| angle_bin(source_angle.get(sx, sy) - ta);
+            let beta = |sx: usize, sy: usize| angle_bin(source.angle.get(sx, sy) - ta);
             // The overlap's pixels that earlier blocks filled (they reach
             // only the left and top overlaps), in row-major order: each
             // one's block offset (index into the tables) and the channels
@@ -157,19 +177,20 @@ fn quilt_blocks(
                     }
                     let (ox, oy) = map.get(bx + x, by + y);
                     offsets.push(y * b + x);
-                    present.extend_from_slice(source.px(ox as usize, oy as usize));
+                    present.extend_from_slice(ch.px(ox as usize, oy as usize));
                 }
             }
-            // Overlap error of a candidate tile origin (sx, sy), summed in
-            // row-major order; once it is over `bound` the rest is skipped
-            // and infinity returned (the sum only grows).
+            // Overlap error of a candidate centre (sx, sy), summed in
+            // row-major order, read from the padded atlas; once it is over
+            // `bound` the rest is skipped and infinity returned (the sum
+            // only grows).
             let overlap_err = |sx: usize, sy: usize, bound: f32| -> f32 {
-                let lin = &padded.linear[beta(sx, sy)];
-                let base = padded.base(sx, sy);
+                let lin = &q.linear[beta(sx, sy)];
+                let base = (sy * ch.width + sx) * d;
                 let mut e = 0.0f32;
                 for (&i, a) in offsets.iter().zip(present.chunks_exact(d)) {
                     let at = base.wrapping_add_signed(lin[i]);
-                    let c = &padded.data[at..at + d];
+                    let c = &ch.data[at..at + d];
                     e += a.iter().zip(c).map(|(p, q)| (p - q) * (p - q)).sum::<f32>();
                     if e > bound {
                         return f32::INFINITY;
@@ -177,26 +198,25 @@ fn quilt_blocks(
                 }
                 e
             };
-            // Every tile position when the tile is small, else a seeded
+            // Every allowed centre when there are few, else a seeded
             // sample. A candidate is kept only when its error is within
             // 10 % of the best, so one whose partial error is already over
             // that much of the best seen so far (in its chunk) is out: its
             // error is left infinite, which changes neither the best nor
             // the kept ones.
-            let count = if sw * sh <= o.candidates {
-                sw * sh
+            let n = q.centres.len();
+            let count = if n <= o.candidates {
+                n
             } else {
                 o.candidates.max(1)
             };
             let position = |k: usize| {
-                if sw * sh <= o.candidates {
-                    (k % sw, k / sw)
+                let (x, y) = if n <= o.candidates {
+                    q.centres[k]
                 } else {
-                    (
-                        rng::index(&[o.seed, bi, k as u64, 0], sw),
-                        rng::index(&[o.seed, bi, k as u64, 1], sh),
-                    )
-                }
+                    Atlas::pick(&q.centres, &[o.seed, bi, k as u64])
+                };
+                (x as usize, y as usize)
             };
             let chunks: Vec<Vec<(usize, usize, f32)>> = (0..count.div_ceil(CHUNK))
                 .into_par_iter()
@@ -212,7 +232,18 @@ fn quilt_blocks(
                         .collect()
                 })
                 .collect();
-            let cands: Vec<(usize, usize, f32)> = chunks.into_iter().flatten().collect();
+            let mut cands: Vec<(usize, usize, f32)> = chunks.into_iter().flatten().collect();
+            if n > o.candidates {
+                let bring = |ox: u32, oy: u32, rx: i64, ry: i64| {
+                    let k = atlas.block_of(oy as usize);
+                    let (x, y) = atlas.bring_in(k, ox as i64 + rx, oy as i64 + ry, q.reach);
+                    atlas.allowed(x, y).then_some((x as usize, y as usize))
+                };
+                let angle = |x: u32, y: u32| source.angle.get(x as usize, y as usize);
+                for (sx, sy) in continuations(&map, &filled, (bx, by), b, ta, angle, bring) {
+                    cands.push((sx, sy, overlap_err(sx, sy, f32::INFINITY)));
+                }
+            }
             let best = cands.iter().map(|c| c.2).fold(f32::INFINITY, f32::min);
             let good: Vec<&(usize, usize, f32)> =
                 cands.iter().filter(|c| c.2 <= keep_bound(best)).collect();
@@ -221,9 +252,9 @@ fn quilt_blocks(
             let be = beta(sx, sy);
             let diff = |x: usize, y: usize| -> f32 {
                 let (ox, oy) = map.get(bx + x, by + y);
-                let a = source.px(ox as usize, oy as usize);
+                let a = ch.px(ox as usize, oy as usize);
                 let (cx, cy) = rot(sx, sy, x, y, be);
-                let c = source.px(cx, cy);
+                let c = ch.px(cx, cy);
                 a.iter().zip(c).map(|(p, q)| (p - q) * (p - q)).sum()
             };
             let left = bx > 0 && ov > 0;
@@ -264,6 +295,45 @@ fn quilt_blocks(
     map
 }
 
+/// The block centres that continue the blocks laid to the left of and
+/// above the block at `(bx, by)` (side `b`): the source of the filled
+/// pixel in the middle of each overlap, moved by that pixel's offset to
+/// the block's centre turned as a block from there is (target angle `ta`,
+/// source angles `angle`), brought into its exemplar by `bring` (`None`
+/// when it may not be a centre). A random sample of centres can miss a
+/// tile's own repeat; these are it.
+fn continuations(
+    map: &Grid<(u32, u32)>,
+    filled: &Grid<bool>,
+    (bx, by): (usize, usize),
+    b: usize,
+    ta: f32,
+    angle: impl Fn(u32, u32) -> f32,
+    bring: impl Fn(u32, u32, i64, i64) -> Option<(usize, usize)>,
+) -> Vec<(usize, usize)> {
+    let (w, h) = (map.width(), map.height());
+    let (cx, cy) = (bx + b / 2, by + b / 2);
+    let mut out = Vec::new();
+    for (px, py) in [(bx, cy.min(h - 1)), (cx.min(w - 1), by)] {
+        if !filled.get(px, py) {
+            continue;
+        }
+        let (ox, oy) = map.get(px, py);
+        let bin = angle_bin(angle(ox, oy) - ta);
+        let a = bin as f32 * std::f32::consts::TAU / ANGLE_BINS as f32;
+        let (sn, cs) = a.sin_cos();
+        let (dx, dy) = (cx as f32 - px as f32, cy as f32 - py as f32);
+        let rx = (cs * dx - sn * dy).round() as i64;
+        let ry = (sn * dx + cs * dy).round() as i64;
+        if let Some(p) = bring(ox, oy, rx, ry) {
+            if !out.contains(&p) {
+                out.push(p);
+            }
+        }
+    }
+    out
+}
+
 /// Candidates whose overlap errors one task computes, with a running best.
 const CHUNK: usize = 256;
 
@@ -272,64 +342,6 @@ const CHUNK: usize = 256;
 #[inline]
 fn keep_bound(best: f32) -> f32 {
     best * 1.1 + 1e-6
-}
-
-/// A source padded by its own wrap-around by the reach of the rotated
-/// block offsets, with each angle bin's offsets as linear indices.
-#[derive(Clone, Debug)]
-struct Padded {
-    /// The source's width, height and depth.
-    dims: (usize, usize, usize),
-    data: Vec<f32>,
-    width: usize,
-    depth: usize,
-    margin: usize,
-    /// Per bin, per block offset: the channel index offset.
-    linear: Vec<Vec<isize>>,
-}
-
-impl Padded {
-    fn new(source: &Channels, tables: &[Vec<(i64, i64)>]) -> Padded {
-        let reach = tables
-            .iter()
-            .flatten()
-            .map(|&(x, y)| x.unsigned_abs().max(y.unsigned_abs()))
-            .max()
-            .unwrap_or(0) as usize;
-        let margin = reach;
-        let (w, h, d) = (source.width, source.height, source.depth);
-        let (pw, ph) = (w + 2 * margin, h + 2 * margin);
-        let mut data = Vec::with_capacity(pw * ph * d);
-        for y in 0..ph {
-            let sy = (y + h * (margin / h + 1) - margin) % h;
-            for x in 0..pw {
-                let sx = (x + w * (margin / w + 1) - margin) % w;
-                data.extend_from_slice(source.px(sx, sy));
-            }
-        }
-        let linear = tables
-            .iter()
-            .map(|t| {
-                t.iter()
-                    .map(|&(rx, ry)| (ry as isize * pw as isize + rx as isize) * d as isize)
-                    .collect()
-            })
-            .collect();
-        Padded {
-            dims: (w, h, d),
-            data,
-            width: pw,
-            depth: d,
-            margin,
-            linear,
-        }
-    }
-
-    /// Index of tile pixel `(x, y)`'s first channel.
-    #[inline]
-    fn base(&self, x: usize, y: usize) -> usize {
-        ((y + self.margin) * self.width + x + self.margin) * self.depth
-    }
 }
 
 /// The minimum-error boundary cut through an error surface `err` of
@@ -506,12 +518,20 @@ mod tests {
                         .map(|i| (i % sw, i / sw, overlap_err(i % sw, i / sw)))
                         .collect()
                 } else {
+                    let bring = |ox: u32, oy: u32, rx: i64, ry: i64| {
+                        Some((
+                            (ox as i64 + rx).rem_euclid(sw as i64) as usize,
+                            (oy as i64 + ry).rem_euclid(sh as i64) as usize,
+                        ))
+                    };
+                    let angle = |x: u32, y: u32| source_angle.get(x as usize, y as usize);
                     (0..o.candidates.max(1))
                         .map(|k| {
-                            let sx = rng::index(&[o.seed, bi, k as u64, 0], sw);
-                            let sy = rng::index(&[o.seed, bi, k as u64, 1], sh);
-                            (sx, sy, overlap_err(sx, sy))
+                            let i = rng::index(&[o.seed, bi, k as u64], sw * sh);
+                            (i % sw, i / sw)
                         })
+                        .chain(continuations(&map, &filled, (bx, by), b, ta, angle, bring))
+                        .map(|(sx, sy)| (sx, sy, overlap_err(sx, sy)))
                         .collect()
                 };
                 let best = cands.iter().map(|c| c.2).fold(f32::INFINITY, f32::min);
@@ -589,18 +609,30 @@ mod tests {
                 candidates: 400,
                 seed,
             };
+            let m = block_reach(block + 2);
+            let source = Source::tile(&src, &sa, m);
+            // Atlas pixels back to tile pixels.
+            let tile = |g: Grid<(u32, u32)>| g.map(|(x, y)| (x - m as u32, y - m as u32));
             let want = reference(&src, &sa, &ta, &o);
-            assert_eq!(quilt(&src, &sa, &ta, &o).data(), want.data(), "seed {seed}");
+            assert_eq!(
+                tile(quilt(&source, &ta, &o)).data(),
+                want.data(),
+                "seed {seed}"
+            );
             // One quilter serves several targets (and another seed).
-            let q = Quilter::new(&src, block);
+            let q = Quilter::new(&source, block);
             for s in [seed, seed + 10] {
                 let o = QuiltOptions { seed: s, ..o };
                 let want = reference(&src, &sa, &ta, &o);
-                assert_eq!(q.quilt(&src, &sa, &ta, &o).data(), want.data(), "seed {s}");
+                assert_eq!(
+                    tile(q.quilt(&source, &ta, &o)).data(),
+                    want.data(),
+                    "seed {s}"
+                );
             }
             // A quilter made for another block size is not misused.
-            let other = Quilter::new(&src, block + 2);
-            assert_eq!(other.quilt(&src, &sa, &ta, &o).data(), want.data());
+            let other = Quilter::new(&source, block + 2);
+            assert_eq!(tile(other.quilt(&source, &ta, &o)).data(), want.data());
         }
     }
 
@@ -615,9 +647,9 @@ mod tests {
             data: (0..256).map(|i| rng::unit(&[9, i]) as f32).collect(),
         };
         let zero = Grid::new(16, 16, 0.0);
+        let source = Source::tile(&src, &zero, block_reach(10));
         let map = quilt(
-            &src,
-            &zero,
+            &source,
             &Grid::new(40, 30, 0.0),
             &QuiltOptions {
                 block: 10,
@@ -626,9 +658,10 @@ mod tests {
                 seed: 1,
             },
         );
+        let m = block_reach(10) as u32;
         let (ax, ay) = map.get(5, 5);
         let (bx, by) = map.get(6, 5);
-        assert_eq!(((ax + 1) % 16, ay), (bx, by));
-        assert_eq!(apply(&src, &map).data.len(), 40 * 30);
+        assert_eq!(((ax - m + 1) % 16 + m, ay), (bx, by));
+        assert_eq!(apply(&source.channels, &map).data.len(), 40 * 30);
     }
 }

@@ -5,7 +5,7 @@
 //! The shipped styles run at a 64 px tile (the `resolution` override) so
 //! the tests stay fast.
 
-use super::tile::{SourceDirection, Tile};
+use super::tile::{Palette, SourceDirection, Swatch, Tile};
 use super::{em, fill_sketch, FillOptions, FillOutput, FillStyle};
 use crate::error::Result;
 use crate::field::diffusion::constant_field;
@@ -70,6 +70,19 @@ fn run(style: &str, name: &str) -> FillOutput {
 fn run_full(style: &str, name: &str) -> FillOutput {
     let sk = sketch::load(&sample(name)).unwrap();
     fill_with(&sk, style, None, &FillOptions::default()).unwrap()
+}
+
+/// The swatch at `path` alone as a tile at `res` px.
+fn tile_of(path: &Path, res: u32, dir: SourceDirection) -> Tile {
+    let sw = Swatch::read(path, res).unwrap();
+    let palette = Palette::of(std::slice::from_ref(&sw)).unwrap();
+    Tile::from_swatch(&sw, &palette, dir)
+}
+
+/// An empty 200 × 200 px sketch (px per unit 1), for a style's scale.
+fn blank_sketch() -> Sketch {
+    Sketch::from_svg(b"<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"200\" height=\"200\"/>")
+        .unwrap()
 }
 
 /// `body` in a 200 × 200 sketch file in `dir`.
@@ -175,12 +188,11 @@ fn combing_turns_the_direction_under_the_stroke() {
 
 #[test]
 fn energy_decreases_over_the_em_iterations_at_each_level() {
-    let tile = Tile::load(
+    let tile = tile_of(
         &root().join("styles/scales/tile.svg"),
         64,
         SourceDirection::Constant([1.0, 0.0]),
-    )
-    .unwrap();
+    );
     let dir = constant_field(96, 96, [1.0, 0.0]);
     let params = em::EmParams {
         levels: 2,
@@ -228,7 +240,7 @@ fn a_direction_file_combs_every_region() {
     )
     .unwrap();
     // Under the stroke the field is the stroke's direction (+x); the
-    // boundary flow there is not.
+    // style's own flow (the rising bands) there is not.
     let r = &combed.regions[0].region;
     let p = r.sdf.to_user.inverse() * Point::new(100.0, 100.0);
     let d = r.direction.get(p.x as usize, p.y as usize);
@@ -284,8 +296,7 @@ fn a_png_tile_fills_a_region() {
     let (f, t) = (r.ink_fraction(), r.tile_ink);
     println!("png stripes: ink {f:.3}, tile {t:.3}");
     assert!((t - 12.0 / 32.0).abs() < 0.05, "{t}");
-    // Straight stripes bent into rings by the boundary flow: without the
-    // histogram weight of the votes this lost a fifth of its ink.
+    // Straight stripes across the circle.
     assert!((f - t).abs() <= 0.15 * t, "ink {f:.3}, tile {t:.3}");
 }
 
@@ -323,7 +334,7 @@ fn the_knot_stays_continuous_under_constant_turning_and_ring_fields() {
     use crate::fill::continuity::junctions;
     use crate::raster::Grid;
     let style = crate::fill::FillStyle::load(&root().join("styles/knot"), None).unwrap();
-    let tile = &style.tile;
+    let tile = &style.tiles[0];
     // The tile itself: no band forks (every crossing passes over/under).
     let (tw, th) = (tile.width(), tile.height());
     let top = tile.layers.len() - 1;
@@ -355,28 +366,38 @@ fn the_knot_stays_continuous_under_constant_turning_and_ring_fields() {
         assert!(regular >= 0.95, "{name}: {regular}");
         assert!(forks <= most, "{name}: {forks}");
     }
-    // The circle sample under its ring-shaped boundary flow: the rings stay
-    // whole; spokes must start as the rings grow, but gaps stay regular.
+    // The circle sample, the weave upright as drawn (the style's flow).
     let out = run_full("knot", "circle");
     let r = &out.regions[0];
     let (regular, forks) = continuity_of(&r.layers, &r.region.sdf.dist, tile);
     println!("circle: regular gaps {regular:.3}, forks {forks:.2} per 10⁴ px");
-    // (With the tile's x axis as its direction the weave tears into
-    // spirals.)
-    assert!(regular >= 0.93, "circle: {regular}");
-    assert!(forks <= 1.2, "circle: {forks}");
+    assert!(regular >= 0.95, "circle: {regular}");
+    assert!(forks <= 0.4, "circle: {forks}");
+    // Under the outline's ring-shaped flow the rings stay whole; spokes
+    // must start as the rings grow, but gaps stay regular. (With the
+    // tile's x axis as its direction the weave tears into spirals.)
+    let (style, region) = knot_circle();
+    let s = em::synthesize_in(tile, &region.direction, Some(&region.mask), &style.params);
+    let (regular, forks) = continuity_of(&s.layers, &region.sdf.dist, tile);
+    println!("circle, outline flow: regular gaps {regular:.3}, forks {forks:.2} per 10⁴ px");
+    assert!(regular >= 0.9, "circle: {regular}");
+    assert!(forks <= 1.5, "circle: {forks}");
 }
 
-/// The knot's circle sample: its style, region and synthesis parameters.
+/// The knot's circle sample under the outline's flow (`flow =
+/// "outline"`, with the tile's edge line as its Shape Hint): the style
+/// and the region.
 fn knot_circle() -> (crate::fill::FillStyle, crate::fill::region::Region) {
-    let style = crate::fill::FillStyle::load(&root().join("styles/knot"), None).unwrap();
+    let mut style = crate::fill::FillStyle::load(&root().join("styles/knot"), None).unwrap();
+    style.flow = crate::fill::Flow::Outline;
+    style.params.shape = em::EmParams::default().shape;
     let sk = sketch::load(&sample("circle")).unwrap();
     let (outline, rule) = first_region(&sk);
     let region = crate::fill::region::Region::rasterize(
         "circle",
         &outline,
         rule,
-        style.px_per_unit(),
+        style.px_per_unit(&sk),
         style.params.radius + 2,
     )
     .unwrap();
@@ -387,7 +408,8 @@ fn knot_circle() -> (crate::fill::FillStyle, crate::fill::region::Region) {
 fn the_shape_hint_puts_the_tiles_edge_band_on_the_outline() {
     let (style, region) = knot_circle();
     // The tile's edge line runs along the rising bands, through ink.
-    let edge = style.tile.edge.expect("edge line");
+    let tile = &style.tiles[0];
+    let edge = tile.edge.expect("edge line");
     assert!((edge.dir[0] - edge.dir[1].abs()).abs() < 1e-9 && edge.dir[1] < 0.0);
     // Ink on the rim (1–4 px inside the outline) with and without the term.
     let rim_ink = |shape: f32| {
@@ -395,7 +417,7 @@ fn the_shape_hint_puts_the_tiles_edge_band_on_the_outline() {
             shape,
             ..style.params
         };
-        let s = em::synthesize_in(&style.tile, &region.direction, Some(&region.mask), &params);
+        let s = em::synthesize_in(tile, &region.direction, Some(&region.mask), &params);
         let rim: Vec<bool> = region
             .sdf
             .dist
@@ -418,7 +440,7 @@ fn the_shape_hint_puts_the_tiles_edge_band_on_the_outline() {
 fn the_energy_with_the_shape_hint_decreases_in_a_region() {
     let (style, region) = knot_circle();
     let s = em::synthesize_in(
-        &style.tile,
+        &style.tiles[0],
         &region.direction,
         Some(&region.mask),
         &style.params,
@@ -481,7 +503,7 @@ fn scales_figures(
 #[test]
 fn the_scales_keep_whole_arcs_in_rows_under_a_constant_field_and_combed() {
     let style = crate::fill::FillStyle::load(&root().join("styles/scales"), None).unwrap();
-    let tile = &style.tile;
+    let tile = &style.tiles[0];
     // A 200×200 px disc under a constant field at 20°.
     let n = 200usize;
     let disc = crate::raster::Grid::from_fn(n, n, |x, y| {
@@ -528,14 +550,13 @@ fn a_pyramid_level_is_added_only_while_every_layer_survives_halving() {
         ..Default::default()
     };
     for (name, res, want) in [("scales", 96, 2), ("knot", 128, 3)] {
-        let tile = Tile::load(
+        let tile = tile_of(
             &root().join(format!("styles/{name}/tile.svg")),
             res,
             SourceDirection::Constant([1.0, 0.0]),
-        )
-        .unwrap();
+        );
         let quarter = tile.half().half();
-        assert_eq!(em::represents_every_layer(&quarter), want == 3, "{name}");
+        assert_eq!(em::represents_every_layer(&[quarter]), want == 3, "{name}");
         let s = em::synthesize(&tile, &dir, &params);
         assert_eq!(s.energy.len(), want, "{name}");
     }
@@ -547,7 +568,7 @@ fn region_of(style: &crate::fill::FillStyle, outline: &BezPath) -> crate::fill::
         "shape",
         outline,
         FillRule::NonZero,
-        style.px_per_unit(),
+        style.px_per_unit(&blank_sketch()),
         style.params.radius + 2,
     )
     .unwrap();
@@ -572,8 +593,9 @@ fn one_prepared_tile_serves_many_regions_as_each_alone() {
         let style =
             crate::fill::FillStyle::load(&root().join("styles").join(name), Some(64)).unwrap();
         let regions: Vec<_> = shapes.iter().map(|s| region_of(&style, s)).collect();
-        let prepared = em::Prepared::new(&style.tile, &style.params);
-        assert_eq!(prepared.tile_ink(0), style.tile.ink_fraction(0));
+        let tile = &style.tiles[0];
+        let prepared = em::Prepared::new(&style.tiles, &style.params);
+        assert_eq!(prepared.tile_ink(0), tile.ink_fraction(0));
         // In order, then again in reverse on the same preparation.
         let order: Vec<usize> = (0..regions.len()).chain((0..regions.len()).rev()).collect();
         for (i, &k) in order.iter().enumerate() {
@@ -584,7 +606,7 @@ fn one_prepared_tile_serves_many_regions_as_each_alone() {
                 seed,
                 ..style.params
             };
-            let alone = em::synthesize_in(&style.tile, &r.direction, Some(&r.mask), &params);
+            let alone = em::synthesize_in(tile, &r.direction, Some(&r.mask), &params);
             assert_eq!(shared.energy, alone.energy, "{name} region {k} (run {i})");
             assert_eq!(shared.layers.len(), alone.layers.len());
             for (a, b) in shared.layers.iter().zip(&alone.layers) {
@@ -619,7 +641,7 @@ fn a_sketch_of_many_shapes_fills_each_as_its_own_synthesis_does() {
             ..style.params
         };
         let s = em::synthesize_in(
-            &style.tile,
+            &style.tiles[0],
             &r.region.direction,
             Some(&r.region.mask),
             &params,
@@ -640,7 +662,142 @@ fn a_sketch_of_many_shapes_fills_each_as_its_own_synthesis_does() {
         for (a, b) in layers.iter().zip(&r.layers) {
             assert_eq!(a.data(), b.data(), "region {qi} ({name})");
         }
-        assert_eq!(r.tile_ink, style.tile.ink_fraction(0));
+        assert_eq!(r.tile_ink, style.tiles[0].ink_fraction(0));
         assert_eq!(r.energy, s.energy, "region {qi}");
+    }
+}
+
+/// A style of two swatches in `dir`: a seamless two-colour tile of
+/// diagonal bands (blue bands 10 units wide, a yellow stripe 4 wide down
+/// each) and a motif on paper (a red ring round a blue dot), each 48
+/// units, read at 64 px.
+fn two_swatch_style(dir: &Path) -> String {
+    let mut bands = String::new();
+    for k in -2..4 {
+        let o = 24.0 * k as f64;
+        bands += &format!(
+            "<path d=\"M{} 0L{} 0L{} 48L{} 48Z\" fill=\"#1f3a80\"/>",
+            o,
+            o + 10.0,
+            o + 10.0 + 48.0,
+            o + 48.0
+        );
+        bands += &format!(
+            "<path d=\"M{} 0L{} 0L{} 48L{} 48Z\" fill=\"#f0c020\"/>",
+            o + 3.0,
+            o + 7.0,
+            o + 7.0 + 48.0,
+            o + 3.0 + 48.0
+        );
+    }
+    std::fs::write(
+        dir.join("bands.svg"),
+        format!(
+            "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"48\" height=\"48\">{bands}</svg>"
+        ),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("ring.svg"),
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"48\" height=\"48\">\
+         <circle cx=\"24\" cy=\"24\" r=\"18\" fill=\"none\" stroke=\"#c02020\" stroke-width=\"5\"/>\
+         <circle cx=\"24\" cy=\"24\" r=\"6\" fill=\"#1f3a80\"/></svg>",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("style.toml"),
+        "kind = \"fill\"\nresolution = 64\nlevels = 2\n\
+         [[exemplar]]\nfile = \"bands.svg\"\n[[exemplar]]\nfile = \"ring.svg\"\n",
+    )
+    .unwrap();
+    dir.to_string_lossy().into_owned()
+}
+
+#[test]
+fn a_style_of_several_swatches_reads_each_as_what_it_is() {
+    let dir = tempfile::tempdir().unwrap();
+    let style = two_swatch_style(dir.path());
+    let st = FillStyle::load(Path::new(&style), None).unwrap();
+    assert_eq!(st.tiles.len(), 2);
+    // One palette over both: blue, yellow, red; no ground (paper shows).
+    assert_eq!(st.ground, None);
+    assert_eq!(st.tiles[0].layers.len(), 3);
+    assert!(st.tiles.iter().all(|t| t.layers.len() == 3));
+    // The bands run on across their seams; the ring is a motif on paper,
+    // its shape the disc it bounds.
+    assert!(st.tiles[0].periodic && st.tiles[0].shape.is_none());
+    let ring = &st.tiles[1];
+    assert!(!ring.periodic);
+    let shape = ring.shape.as_ref().unwrap();
+    let (w, h) = (shape.width(), shape.height());
+    assert!(shape.get(w / 2, h / 2) && !shape.get(1, 1));
+    let area = shape.data().iter().filter(|&&s| s).count() as f64;
+    // Radius 20.5 units (the ring's outer edge) at 64 px per 48 units.
+    let disc = std::f64::consts::PI * (20.5f64 * 64.0 / 48.0).powi(2);
+    assert!((area / disc - 1.0).abs() < 0.1, "{area} vs {disc}");
+    assert_eq!(st.exemplar("ring.svg"), Some(1));
+    assert_eq!(st.exemplar("nope.svg"), None);
+}
+
+#[test]
+fn a_region_may_pin_one_swatch_and_the_option_pins_the_rest() {
+    let dir = tempfile::tempdir().unwrap();
+    let style = two_swatch_style(dir.path());
+    let body = r##"<circle cx="50" cy="50" r="40" fill="#ccc"/>
+<rect x="110" y="20" width="80" height="80" fill="#ccc" data-exemplar="ring.svg"/>"##;
+    let sk = sketch::load(Path::new(&write_sketch(dir.path(), "s.svg", body))).unwrap();
+    let out = fill_with(&sk, &style, None, &FillOptions::default()).unwrap();
+    assert_eq!(out.regions[0].exemplars, vec![0, 1]);
+    assert_eq!(out.regions[1].exemplars, vec![1]);
+    // The pinned region's own synthesis is the ring's alone.
+    let only = FillOptions {
+        exemplar: Some("bands.svg".into()),
+        ..FillOptions::default()
+    };
+    let out = fill_with(&sk, &style, None, &only).unwrap();
+    assert_eq!(out.regions[0].exemplars, vec![0]);
+    assert_eq!(out.regions[1].exemplars, vec![1]);
+    let e = fill_with(
+        &sk,
+        &style,
+        None,
+        &FillOptions {
+            exemplar: Some("nope.svg".into()),
+            ..FillOptions::default()
+        },
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("q-1") && e.contains("nope.svg") && e.contains("bands.svg, ring.svg"),
+        "{e}"
+    );
+}
+
+#[test]
+fn several_swatches_in_several_colours_give_identical_bytes_on_one_and_two_threads() {
+    let dir = tempfile::tempdir().unwrap();
+    let style = two_swatch_style(dir.path());
+    let body = r##"<circle cx="60" cy="60" r="50" fill="#ccc"/>
+<path d="M120 30 L190 40 L170 180 L110 150 Z" fill="#ccc"/>
+<rect x="10" y="120" width="90" height="70" fill="#ccc" data-exemplar="ring.svg"/>"##;
+    let sk = sketch::load(Path::new(&write_sketch(dir.path(), "s.svg", body))).unwrap();
+    let svg = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            fill_with(&sk, &style, None, &FillOptions::default())
+                .unwrap()
+                .to_document()
+                .to_svg()
+        })
+    };
+    let one = svg(1);
+    assert_eq!(one, svg(2));
+    // All three colours are drawn.
+    for c in ["#1f3a80", "#f0c020", "#c02020"] {
+        assert!(one.contains(c), "{c} missing");
     }
 }

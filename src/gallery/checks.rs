@@ -5,7 +5,12 @@
 //!   outside the region beyond the tracing tolerance; forks of the top
 //!   layer's bands and the regularity of its gaps within 20 % of the
 //!   swatch's own (`fill::continuity`); the finest level's synthesis energy
-//!   below its initialization's.
+//!   below its initialization's. The swatches' own figures are pooled over
+//!   all of a style's swatches: a seamless tile measured on its 3 × 3
+//!   repetition's centre copy, any other swatch on itself more than 6 px
+//!   inside its shape (a motif on paper) or its border; ink as a share of
+//!   the pattern (a motif's shape, not the paper round it). Gap regularity
+//!   is left out for a region too narrow to hold a whole gap.
 //! - pattern (stroke-pattern-synthesis.txt §3): elements placed, their
 //!   nearest-neighbour spacing within 20 % of the example's.
 //! - brush (decobrush.txt §5–7): ink covers 95 % of the path within half
@@ -19,7 +24,8 @@
 use crate::brush::measure::{ink, ExemplarFigures, Fidelity};
 use crate::brush::output::brush_sketch;
 use crate::brush::pipeline::Settings;
-use crate::fill::continuity::{junctions, regular_gaps, tile_gap_area};
+use crate::fill::continuity::{junctions, pieces, regular_gaps};
+use crate::fill::tile::Tile;
 use crate::library::{Style, StyleOptions};
 use crate::raster::Grid;
 use crate::read::sketch;
@@ -332,7 +338,8 @@ fn worst(values: impl Iterator<Item = f64>, higher_is_better: bool, none: f64) -
 
 /// Forks of the top layer's bands per 10⁴ px and the share of regular
 /// gaps of the bottom layer, where `counted` (the tile's centre copy, or
-/// the region's inside more than 6 px from its outline).
+/// the region's inside more than 6 px from its outline); no share when no
+/// gap lies wholly where counted.
 fn continuity(
     bottom: &Grid<bool>,
     top: &Grid<bool>,
@@ -342,8 +349,81 @@ fn continuity(
     let area = counted.data().iter().filter(|&&c| c).count().max(1) as f64;
     let forks = junctions(top, counted, 4) as f64 * 1e4 / area;
     let paper = Grid::from_fn(bottom.width(), bottom.height(), |x, y| !bottom.get(x, y));
-    let gaps = (gap > 0.0).then(|| regular_gaps(&paper, counted, gap, 1.6));
+    // A region too narrow to hold a whole gap says nothing of their
+    // regularity.
+    let whole = pieces(&paper, counted).iter().any(|p| p.within);
+    let gaps = (gap > 0.0 && whole).then(|| regular_gaps(&paper, counted, gap, 1.6));
     (forks, gaps)
+}
+
+/// One swatch as the checks see it: its bottom and top layers' ink and
+/// where it counts. A seamless tile is measured on its 3 × 3 repetition's
+/// centre copy (so bands crossing its seams are whole); any other swatch
+/// on its own shape, more than 6 px inside it.
+struct SwatchInk {
+    bottom: Grid<bool>,
+    top: Grid<bool>,
+    counted: Grid<bool>,
+    /// Areas of its gaps (paper pieces): a tile's that touch the centre
+    /// copy without reaching the repetition's edge, a swatch's that lie
+    /// wholly where counted.
+    gaps: Vec<usize>,
+}
+
+impl SwatchInk {
+    fn of(tile: &Tile) -> SwatchInk {
+        let nl = tile.layers.len();
+        let (tw, th) = (tile.width(), tile.height());
+        if tile.periodic {
+            let rep = |k: usize| {
+                Grid::from_fn(3 * tw, 3 * th, |x, y| {
+                    tile.layers[k].sdf.get(x % tw, y % th) < 0.0
+                })
+            };
+            let bottom = rep(0);
+            let counted = Grid::from_fn(3 * tw, 3 * th, |x, y| {
+                (tw..2 * tw).contains(&x) && (th..2 * th).contains(&y)
+            });
+            let inner = Grid::from_fn(3 * tw, 3 * th, |x, y| {
+                x > 0 && y > 0 && x + 1 < 3 * tw && y + 1 < 3 * th
+            });
+            let paper = bottom.map(|b| !b);
+            let gaps = pieces(&paper, &inner)
+                .into_iter()
+                .zip(pieces(&paper, &counted))
+                .filter(|(a, c)| a.within && c.touches)
+                .map(|(a, _)| a.area)
+                .collect();
+            SwatchInk {
+                bottom,
+                top: rep(nl - 1),
+                counted,
+                gaps,
+            }
+        } else {
+            let shape = tile
+                .shape
+                .clone()
+                .unwrap_or_else(|| Grid::new(tw, th, true));
+            let d2 = crate::raster::edt::squared_edt(&shape.map(|s| !s));
+            let layer = |k: usize| tile.layers[k].sdf.map(|d| d < 0.0);
+            let bottom = layer(0);
+            let counted = Grid::from_fn(tw, th, |x, y| {
+                x >= 6 && y >= 6 && x + 6 < tw && y + 6 < th && d2.get(x, y) > 36.0
+            });
+            let gaps = pieces(&bottom.map(|b| !b), &counted)
+                .into_iter()
+                .filter(|p| p.within)
+                .map(|p| p.area)
+                .collect();
+            SwatchInk {
+                bottom,
+                top: layer(nl - 1),
+                counted,
+                gaps,
+            }
+        }
+    }
 }
 
 fn fill(style: &Path, input: &Path) -> Outcome {
@@ -356,20 +436,45 @@ fn fill(style: &Path, input: &Path) -> Outcome {
         &crate::fill::FillOptions::default(),
     )?;
     let svg = out.to_document().to_svg();
-    let tile = &fs.tile;
-    let nl = tile.layers.len();
-    // The swatch's own figures on its 3 × 3 repetition's centre copy.
-    let (tw, th) = (tile.width(), tile.height());
-    let rep = |k: usize| {
-        Grid::from_fn(3 * tw, 3 * th, |x, y| {
-            tile.layers[k].sdf.get(x % tw, y % th) < 0.0
-        })
-    };
-    let centre = Grid::from_fn(3 * tw, 3 * th, |x, y| {
-        (tw..2 * tw).contains(&x) && (th..2 * th).contains(&y)
+    let tiles = &fs.tiles;
+    let nl = tiles[0].layers.len();
+    // The swatches' own figures, pooled: ink per layer over their
+    // patterns, forks per 10⁴ counted px, the median gap and the share of
+    // regular gaps.
+    let inks: Vec<SwatchInk> = tiles.iter().map(SwatchInk::of).collect();
+    let area: usize = tiles.iter().map(|t| t.area()).sum();
+    let own_ink =
+        |k: usize| tiles.iter().map(|t| t.ink_px(k)).sum::<usize>() as f64 / area.max(1) as f64;
+    let mut gap_areas: Vec<usize> = inks.iter().flat_map(|s| s.gaps.clone()).collect();
+    gap_areas.sort_unstable();
+    let gap = gap_areas
+        .get(gap_areas.len() / 2)
+        .map_or(0.0, |&a| a as f64);
+    let counted_px: usize = inks
+        .iter()
+        .map(|s| s.counted.data().iter().filter(|&&c| c).count())
+        .sum();
+    let tile_forks = inks
+        .iter()
+        .map(|s| junctions(&s.top, &s.counted, 4))
+        .sum::<usize>() as f64
+        * 1e4
+        / counted_px.max(1) as f64;
+    let tile_gaps = (gap > 0.0).then(|| {
+        let (ok, all) = inks.iter().fold((0.0, 0.0), |(ok, all), s| {
+            let paper = s.bottom.map(|b| !b);
+            let n = pieces(&paper, &s.counted)
+                .iter()
+                .filter(|p| p.within)
+                .count() as f64;
+            (ok + regular_gaps(&paper, &s.counted, gap, 1.6) * n, all + n)
+        });
+        if all > 0.0 {
+            ok / all
+        } else {
+            0.0
+        }
     });
-    let gap = tile_gap_area(&tile.layers[0].sdf.map(|d| d >= 0.0));
-    let (tile_forks, tile_gaps) = continuity(&rep(0), &rep(nl - 1), &centre, gap);
     let mut ink_err: Vec<f64> = Vec::new();
     let mut blank: Vec<f64> = Vec::new();
     let mut outside: Vec<f64> = Vec::new();
@@ -389,7 +494,7 @@ fn fill(style: &Path, input: &Path) -> Outcome {
                 / area
         };
         for k in 0..nl {
-            let own = tile.ink_fraction(k);
+            let own = own_ink(k);
             if own >= 0.01 {
                 ink_err.push((fraction(k) / own - 1.0).abs());
             }

@@ -25,6 +25,7 @@ use kurbo::Affine;
 use rayon::prelude::*;
 use resvg::tiny_skia;
 use resvg::usvg;
+#[cfg(test)]
 use std::path::Path;
 
 /// One layer of ink.
@@ -54,12 +55,14 @@ pub struct Ink {
 }
 
 /// Reads `path` (raster or SVG, told apart by content) as ink.
+#[cfg(test)]
 pub fn load(path: &Path, opts: &ImageOptions) -> Result<Ink> {
     let bytes = io::read_file(path)?;
     read(&bytes, opts).map_err(|e| e.in_file(path))
 }
 
 /// Reads raster or SVG bytes (told apart by content) as ink.
+#[cfg(test)]
 pub fn read(bytes: &[u8], opts: &ImageOptions) -> Result<Ink> {
     if looks_like_svg(bytes) {
         read_svg(bytes, opts)
@@ -373,8 +376,24 @@ pub fn svg_ink(tree: &usvg::Tree, opts: &ImageOptions, skip_id: Option<&str>) ->
     let (pw, ph) = ((uw * scale).ceil() as u64, (uh * scale).ceil() as u64);
     io::check_canvas(pw.max(1), ph.max(1))?;
     let (pw, ph) = (pw.max(1) as usize, ph.max(1) as usize);
-    let canvas = tiny_skia::Transform::from_scale(scale as f32, scale as f32);
-    let to_user = Affine::scale(1.0 / scale);
+    svg_ink_on(tree, opts, skip_id, (pw, ph), (scale, scale))
+}
+
+/// The ink of a parsed SVG `tree` as [`svg_ink`] reads it, on a `size`
+/// px canvas at `scale` px per user unit in x and y (so that a seamless
+/// tile can fill whole pixels exactly: its pixel grid then ends where its
+/// repeat does). The caller checks the canvas size.
+pub fn svg_ink_on(
+    tree: &usvg::Tree,
+    opts: &ImageOptions,
+    skip_id: Option<&str>,
+    (pw, ph): (usize, usize),
+    (sx, sy): (f64, f64),
+) -> Result<Ink> {
+    let size = tree.size();
+    let (uw, uh) = (size.width() as f64, size.height() as f64);
+    let canvas = tiny_skia::Transform::from_scale(sx as f32, sy as f32);
+    let to_user = Affine::scale_non_uniform(1.0 / sx, 1.0 / sy);
     if needs_render(tree.root()) {
         return rendered_ink(tree, opts, skip_id, (pw, ph), canvas, to_user);
     }
@@ -449,6 +468,13 @@ pub fn svg_ink(tree: &usvg::Tree, opts: &ImageOptions, skip_id: Option<&str>) ->
         return Ok(ink);
     }
     let mut layers = Vec::new();
+    let mut notes = Vec::new();
+    let gradients = gradient_fills(tree.root());
+    if gradients > 0 {
+        notes.push(format!(
+            "{gradients} gradient fill(s) read as the mean colour of their stops"
+        ));
+    }
     for LayerShapes {
         color,
         members,
@@ -470,6 +496,28 @@ pub fn svg_ink(tree: &usvg::Tree, opts: &ImageOptions, skip_id: Option<&str>) ->
         height: uh,
         layers,
         warnings: Vec::new(),
-        notes: Vec::new(),
+        notes,
     })
+}
+
+/// The visible fills and strokes of `group` painted with a gradient.
+fn gradient_fills(group: &usvg::Group) -> usize {
+    let grad = |p: &usvg::Paint| {
+        matches!(
+            p,
+            usvg::Paint::LinearGradient(_) | usvg::Paint::RadialGradient(_)
+        )
+    };
+    group
+        .children()
+        .iter()
+        .map(|n| match n {
+            usvg::Node::Group(g) => gradient_fills(g),
+            usvg::Node::Path(p) if p.is_visible() => {
+                usize::from(p.fill().is_some_and(|f| grad(f.paint())))
+                    + usize::from(p.stroke().is_some_and(|s| grad(s.paint())))
+            }
+            _ => 0,
+        })
+        .sum()
 }

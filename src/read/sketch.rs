@@ -6,10 +6,11 @@
 //! - a shape with a visible stroke and no fill is an **open query path**
 //!   (its geometry is the spine, its stroke width the intended width).
 //!
-//! A shape (or an ancestor group) may carry `data-style="NAME"`. usvg drops
-//! unknown attributes, so the raw XML is read first with roxmltree (the
-//! parser usvg itself uses) and shapes carrying a style without an `id` get
-//! a private one, mapped back here.
+//! A shape (or an ancestor group) may carry `data-style="NAME"`, and a
+//! filled one `data-exemplar="FILE"` (one swatch of its fill style). usvg
+//! drops unknown attributes, so the raw XML is read first with roxmltree
+//! (the parser usvg itself uses) and shapes without an `id` get a private
+//! one, mapped back here.
 //!
 //! Query geometry is in the sketch's user units (its `viewBox` space), so an
 //! output written with the sketch's `width`, `height` and `viewBox`
@@ -84,6 +85,9 @@ pub struct Sketch {
     pub view_box: Rect,
     /// The queries in document order.
     pub queries: Vec<Query>,
+    /// The `data-exemplar` of a region (of the shape or its nearest
+    /// ancestor), by query id.
+    pub exemplars: BTreeMap<String, String>,
     /// Things ignored, one line each, for `--verbose`.
     pub notes: Vec<String>,
     /// Shapes the designer drew that cannot be used (no length, zero
@@ -166,6 +170,7 @@ pub fn parse(data: &[u8]) -> Result<Sketch> {
         height,
         view_box,
         queries: Vec::new(),
+        exemplars: BTreeMap::new(),
         notes: Vec::new(),
         warnings: Vec::new(),
         backdrop: None,
@@ -173,6 +178,7 @@ pub fn parse(data: &[u8]) -> Result<Sketch> {
     };
     let mut read = Read {
         styles: &pre.styles,
+        exemplars: &pre.exemplars,
         elements: &pre.elements,
         backdrop: Backdrop {
             text: text.to_string(),
@@ -192,6 +198,8 @@ struct Preprocessed {
     aspect: String,
     /// element id → data-style
     styles: BTreeMap<String, String>,
+    /// element id → data-exemplar
+    exemplars: BTreeMap<String, String>,
     /// element id → where it stands in the text, for elements that can be
     /// replaced in place (drawn where they stand, their id unique)
     elements: BTreeMap<String, Element>,
@@ -211,6 +219,7 @@ struct Element {
 /// sketch.
 struct Read<'a> {
     styles: &'a BTreeMap<String, String>,
+    exemplars: &'a BTreeMap<String, String>,
     elements: &'a BTreeMap<String, Element>,
     backdrop: Backdrop,
 }
@@ -233,6 +242,7 @@ fn preprocess(text: &str) -> Result<Preprocessed> {
         .unwrap_or("xMidYMid meet")
         .to_string();
     let mut styles = BTreeMap::new();
+    let mut exemplars = BTreeMap::new();
     let mut elements = BTreeMap::new();
     let mut seen = std::collections::BTreeSet::new();
     let mut twice = std::collections::BTreeSet::new();
@@ -249,10 +259,12 @@ fn preprocess(text: &str) -> Result<Preprocessed> {
         if !SHAPES.contains(&node.tag_name().name()) {
             continue;
         }
-        let style = node
-            .ancestors()
-            .filter(|a| a.is_element())
-            .find_map(|a| a.attribute("data-style"));
+        let inherited = |name: &str| {
+            node.ancestors()
+                .filter(|a| a.is_element())
+                .find_map(|a| a.attribute(name))
+        };
+        let (style, exemplar) = (inherited("data-style"), inherited("data-exemplar"));
         let id = match node.attribute("id") {
             Some(id) if !id.is_empty() => id.to_string(),
             _ => {
@@ -266,6 +278,9 @@ fn preprocess(text: &str) -> Result<Preprocessed> {
                 id
             }
         };
+        if let Some(e) = exemplar {
+            exemplars.insert(id.clone(), e.to_string());
+        }
         if let Some(style) = style {
             styles.insert(id.clone(), style.to_string());
         }
@@ -295,6 +310,7 @@ fn preprocess(text: &str) -> Result<Preprocessed> {
         view_box,
         aspect,
         styles,
+        exemplars,
         elements,
         end: closing_tag(text, root.range()),
     })
@@ -431,6 +447,9 @@ fn add_path(p: &usvg::Path, to_user: Affine, read: &mut Read, sk: &mut Sketch) {
             usvg::FillRule::NonZero => FillRule::NonZero,
             usvg::FillRule::EvenOdd => FillRule::EvenOdd,
         };
+        if let Some(e) = read.exemplars.get(p.id()) {
+            sk.exemplars.insert(id.clone(), e.clone());
+        }
         sk.queries.push(Query {
             id,
             style,
@@ -487,6 +506,22 @@ mod tests {
         assert_eq!(s.queries[1].id, "q-2");
         assert_eq!(s.queries[1].style.as_deref(), Some("stipple"));
         assert!(matches!(s.queries[1].kind, QueryKind::Region { .. }));
+        assert!(s.exemplars.is_empty());
+    }
+
+    #[test]
+    fn a_region_may_pin_an_exemplar() {
+        let svg = r##"<svg xmlns="http://www.w3.org/2000/svg" width="200" height="100">
+            <g data-exemplar="b.svg"><rect x="10" y="10" width="50" height="50" fill="#f00"/></g>
+            <circle id="c" cx="150" cy="50" r="30" fill="#00f" data-exemplar="a.svg" data-style="s"/>
+            <rect x="80" y="10" width="20" height="20" fill="#0f0"/>
+        </svg>"##;
+        let s = parse(svg.as_bytes()).unwrap();
+        assert_eq!(s.queries.len(), 3);
+        assert_eq!(s.exemplars.get("q-1").map(String::as_str), Some("b.svg"));
+        assert_eq!(s.exemplars.get("c").map(String::as_str), Some("a.svg"));
+        assert_eq!(s.queries[1].style.as_deref(), Some("s"));
+        assert!(!s.exemplars.contains_key("q-3"));
     }
 
     /// A shape whose coordinates run past `MAX_COORD` (an arc of 1e308, a

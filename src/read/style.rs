@@ -19,6 +19,10 @@ pub const MAX_EXEMPLARS: usize = 100;
 /// The file name of a style's description inside its folder.
 pub const STYLE_FILE: &str = "style.toml";
 
+/// Most swatches a fill style may list: every one is a source of every
+/// synthesis, held at its `resolution` with its pyramid.
+pub const MAX_FILL_EXEMPLARS: usize = 32;
+
 /// What a style library is for (`kind = "..."`).
 #[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq)]
 #[serde(rename_all = "lowercase")]
@@ -83,7 +87,8 @@ pub struct StyleToml {
     pub exemplar: Vec<ExemplarToml>,
     /// Pattern: ε, the distance in the example's user units below which
     /// strokes are perceived as one element (Barla et al. §2.2).
-    /// Fill: sketch units per tile user unit (default 1).
+    /// Fill: sketch units per user unit of the first exemplar (default:
+    /// each exemplar's longest side spans `resolution` px of the sketch).
     pub scale: Option<f64>,
     /// Pattern: neighbourhood size in rings of the neighbour graph used
     /// when matching (Barla et al. §3.1, 1..=6; default 2).
@@ -96,14 +101,16 @@ pub struct StyleToml {
     pub dimension: Option<u8>,
     /// Pattern: maximum Lloyd iterations for 2-D seeds (1..=1000; default 60).
     pub lloyd_iterations: Option<u32>,
-    /// Fill: the tile's own direction, `"etf"` (estimated from the tile,
-    /// Brushables §3.1) or a constant `[x, y]` in the tile's axes (y down).
+    /// Fill: the swatches' own direction, a constant `[x, y]` in their
+    /// axes (y down; default `[1, 0]`, their x axis) or `"etf"` (estimated
+    /// from each swatch, Brushables §3.1, for textures that flow).
     pub direction: Option<DirectionToml>,
-    /// Fill: what the tile's `direction` follows in a shape that no stroke
-    /// combs: `"outline"` (the outline's flow, Brushables §3.1; the
-    /// default) or a constant `[x, y]` in the sketch's axes (y down), for
-    /// patterns with one "up" such as scales, which cannot follow the vortex
-    /// that the flow of a closed outline turns around.
+    /// Fill: what the swatches' `direction` follows in a shape that no
+    /// stroke combs: a constant `[x, y]` in the sketch's axes (y down;
+    /// default `[1, 0]`: the swatch upright, as drawn) or `"outline"` (the
+    /// outline's flow, Brushables §3.1, for bands that should run round a
+    /// shape; a pattern with one "up" cannot follow the vortex that the
+    /// flow of a closed outline turns around).
     pub flow: Option<DirectionToml>,
     /// Fill: finest patch side in tile pixels (odd, 3..=33; default 9).
     pub patch: Option<u32>,
@@ -292,7 +299,7 @@ impl StyleToml {
         Ok(())
     }
 
-    /// The fill keys: ranges, and exactly one tile.
+    /// The fill keys: ranges, and one to [`MAX_FILL_EXEMPLARS`] swatches.
     fn validate_fill(&self, path: &Path) -> Result<()> {
         let bad =
             |key: &str, why: String| Err(Error::invalid(format!("{key}: {why}")).in_file(path));
@@ -318,11 +325,11 @@ impl StyleToml {
                 return bad("alpha", format!("must be within 0..1, got {a}"));
             }
         }
-        if self.exemplar.len() != 1 {
+        if self.exemplar.is_empty() || self.exemplar.len() > MAX_FILL_EXEMPLARS {
             return bad(
                 "exemplar",
                 format!(
-                    "a fill style takes exactly one tile (SVG or PNG), found {}",
+                    "a fill style takes 1 to {MAX_FILL_EXEMPLARS} swatches (SVG or PNG), found {}",
                     self.exemplar.len()
                 ),
             );

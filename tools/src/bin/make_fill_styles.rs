@@ -149,18 +149,19 @@ fn main() -> std::io::Result<()> {
     // turned both families into spirals whose spacing must change with the
     // radius, and the weave tore everywhere; along one family, that family
     // becomes unbroken rings and only the other (the spokes) must end.
-    // The flow is what that direction follows in a shape no stroke combs:
-    // the knot's bands read the same turned by 180° and follow the
-    // outline's flow, rings and all; the scales have one "up" and cannot
-    // follow the vortex that the flow of a closed outline turns around, so
-    // their rows run straight across unless strokes comb them.
+    // The flow is what that direction follows in a shape no stroke combs.
+    // The knot keeps its over-under weave upright as drawn (under the
+    // outline's flow a round shape turns it into rings and spokes, which
+    // must break somewhere); the scales have one "up" and cannot follow
+    // the vortex that the flow of a closed outline turns around: both run
+    // straight across unless strokes comb them.
     for (name, tile, dir, says, flow) in [
         (
             "knot",
             knot(),
             "[1.0, -1.0]",
             "The bands rising to the right follow the region's direction field.",
-            "# The field follows the shape's outline where no stroke combs it.\nflow = \"outline\"",
+            "# Where no stroke combs the shape, the weave stays upright as drawn.\nflow = [1.0, -1.0]",
         ),
         (
             "scales",
