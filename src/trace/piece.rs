@@ -595,7 +595,9 @@ impl Piece<'_> {
                 let s = t * len;
                 if l > 1e-9 {
                     v / l
-                } else if self.corner_start && s < CORNER_REACH || self.corner_end && len - s < CORNER_REACH {
+                } else if self.corner_start && s < CORNER_REACH
+                    || self.corner_end && len - s < CORNER_REACH
+                {
                     self.chord_dir(s, self.corner_start && s < CORNER_REACH)
                 } else {
                     self.seg_dir(i)
