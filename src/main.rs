@@ -191,6 +191,11 @@ struct TraceArgs {
     /// Trace each fill colour separately and stack the layers.
     #[arg(long)]
     layers: bool,
+    /// With --layers: each colour's region (the paper's too) a shape of
+    /// its own, neighbours sharing exactly the same boundary curves, so
+    /// nothing overlaps and no seam shows (cutting plotters, embroidery).
+    #[arg(long, requires = "layers", conflicts_with = "invert")]
+    cutout: bool,
 }
 
 #[derive(Args)]
@@ -295,7 +300,12 @@ fn run_trace(args: TraceArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
     input.validate()?;
     let job = |inp: &Path| -> Result<String, Error> {
         let bytes = io::read_file(inp)?;
-        let out = Image::from_bytes(&bytes, &input)
+        let image = if args.cutout {
+            Image::regions_from_bytes(&bytes, &input)
+        } else {
+            Image::from_bytes(&bytes, &input)
+        };
+        let out = image
             .and_then(|image| flourish::trace(&image, &opts))
             .map_err(|e| e.in_file(inp))?;
         Ok(report(inp, out, quiet, verbose))

@@ -6,6 +6,7 @@ pub mod bitmap;
 pub mod contour;
 pub mod edt;
 pub mod plain;
+pub mod regions;
 pub mod scan;
 pub mod sdf;
 pub mod vector;

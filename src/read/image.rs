@@ -8,6 +8,7 @@ use super::ImageOptions;
 use crate::error::{Error, Result};
 use crate::io;
 use crate::outline::paths::Bitmap;
+use crate::raster::regions::Partition;
 use crate::raster::{Coverage, Grid};
 use crate::svg_out::Color;
 use rayon::prelude::*;
@@ -119,6 +120,73 @@ pub(super) fn raster_coverage(
         }
     }
     Ok((pixel_coverage(&px, w, h, opts), lighting))
+}
+
+/// A raster's pixels read as regions of its palette's colours (see
+/// [`crate::raster::regions`]): the partition and each colour, the
+/// paper's first; with the uneven light of a photo divided out first, as
+/// for the layers.
+pub(super) fn raster_partition(bytes: &[u8]) -> Result<(Partition, Vec<Color>, Option<Lighting>)> {
+    let img = decode_raster(bytes)?;
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    let mut px: Vec<[u8; 4]> = match img {
+        image::DynamicImage::ImageRgb8(rgb) => rgb
+            .as_raw()
+            .chunks_exact(3)
+            .map(|c| [c[0], c[1], c[2], 255])
+            .collect(),
+        image::DynamicImage::ImageRgba8(rgba) => rgba
+            .as_raw()
+            .chunks_exact(4)
+            .map(|c| [c[0], c[1], c[2], c[3]])
+            .collect(),
+        other => other.to_rgba8().pixels().map(|p| p.0).collect(),
+    };
+    let mut lighting = None;
+    if px.iter().all(|p| p[3] == 255) {
+        let at = |x: usize, y: usize| {
+            px.get(y * w + x).map_or(255, |p| {
+                crate::raster::round_positive(luma(p) * 255.0) as u8
+            })
+        };
+        lighting = Lighting::measure(w, h, at);
+        if let Some(light) = &lighting {
+            light.flatten_rgba(&mut px);
+        }
+    }
+    let (partition, colours) = pixel_partition(&px, w, h)?;
+    Ok((partition, colours, lighting))
+}
+
+/// `w` × `h` RGBA pixels as regions of their palette's colours, with the
+/// colours (the paper's first).
+pub(super) fn pixel_partition(
+    px: &[[u8; 4]],
+    w: usize,
+    h: usize,
+) -> Result<(Partition, Vec<Color>)> {
+    let has_alpha = px.iter().any(|p| p[3] < 255);
+    let palette = Palette::of(px, w, h, has_alpha, false);
+    let mut mixes = vec![(0u8, 0u8, 1f32); w * h];
+    mixes
+        .par_chunks_mut((MIX_ROWS * w).max(1))
+        .enumerate()
+        .for_each(|(band, out)| {
+            let first = band * MIX_ROWS;
+            palette.mixes(
+                px,
+                w,
+                first..(first + MIX_ROWS).min(h),
+                &mut |i, (a, b, t)| {
+                    out[i - first * w] = (a as u8, b as u8, t);
+                },
+            )
+        });
+    let k = palette.colours.len();
+    let colours = (0..k).map(|j| palette.colour(j)).collect();
+    let partition = Partition::new(w, h, k, mixes)
+        .ok_or_else(|| Error::invalid("the picture's colours do not make a partition"))?;
+    Ok((partition, colours))
 }
 
 /// `rgb` as a grey image when every pixel's three channels are equal,
@@ -530,6 +598,233 @@ fn mean_ink_colour(px: &[[u8; 4]], cov: &Coverage) -> Color {
     Color::rgb((sum[0] / n) as u8, (sum[1] / n) as u8, (sum[2] / n) as u8)
 }
 
+/// A colour raster's palette of dominant colours, the paper's first (the
+/// most common colour on the border, white when none), and how each
+/// pixel is read as a mix of two of them.
+struct Palette {
+    /// Colours (RGB, 0..=255), the paper's first.
+    colours: Vec<[f32; 3]>,
+    /// Pairs `(a ≤ b)` of palette indices with the difference of their
+    /// colours and its squared length.
+    pairs: Vec<(usize, usize, [f32; 3], f32)>,
+    has_alpha: bool,
+}
+
+/// Squared distance between two RGB colours.
+fn dist2(a: &[f32; 3], b: &[f32; 3]) -> f32 {
+    (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f32>()
+}
+
+/// The 12-bit histogram key of an RGB colour (4 bits a channel).
+fn colour_key(c: &[f32; 3]) -> u32 {
+    ((c[0] as u32 >> 4) << 8) | ((c[1] as u32 >> 4) << 4) | (c[2] as u32 >> 4)
+}
+
+impl Palette {
+    /// The palette of `w` × `h` RGBA pixels (see [`quantized_layers`]):
+    /// colours that fill patches of their own, most common first, at
+    /// least 48 levels apart, at most 8, the paper moved to the front;
+    /// only the paper with `paper_only`.
+    fn of(px: &[[u8; 4]], w: usize, h: usize, has_alpha: bool, paper_only: bool) -> Palette {
+        let rgb = |p: &[u8; 4]| composite(p, has_alpha);
+        let keys: Vec<u16> = px.par_iter().map(|p| colour_key(&rgb(p)) as u16).collect();
+        // Per colour bin: pixels, pixels inside a patch of the colour (their
+        // four neighbours in the same bin), and the sum of the colours.
+        // (Keys are 12 bits: one slot per key, visited in key order.) Bands
+        // of rows are counted in parallel and added up in order, so the sums
+        // do not depend on the thread count.
+        type Bin = (u64, u64, [f64; 3]);
+        const BAND: usize = 64;
+        let bands: Vec<Vec<Bin>> = (0..h.div_ceil(BAND))
+            .into_par_iter()
+            .map(|band| {
+                let mut hist: Vec<Bin> = vec![(0, 0, [0.0; 3]); 1 << 12];
+                for y in band * BAND..((band + 1) * BAND).min(h) {
+                    let row = y * w;
+                    for x in 0..w {
+                        let i = row + x;
+                        let k = keys[i];
+                        let interior = x > 0
+                            && y > 0
+                            && x + 1 < w
+                            && y + 1 < h
+                            && keys[i - 1] == k
+                            && keys[i + 1] == k
+                            && keys[i - w] == k
+                            && keys[i + w] == k;
+                        let Some(e) = hist.get_mut(usize::from(k)) else {
+                            continue;
+                        };
+                        e.0 += 1;
+                        e.1 += u64::from(interior);
+                        for (sum, v) in e.2.iter_mut().zip(rgb(&px[i])) {
+                            *sum += v as f64;
+                        }
+                    }
+                }
+                hist
+            })
+            .collect();
+        let mut hist: Vec<Bin> = vec![(0, 0, [0.0; 3]); 1 << 12];
+        for band in &bands {
+            for (e, b) in hist.iter_mut().zip(band) {
+                e.0 += b.0;
+                e.1 += b.1;
+                for (s, v) in e.2.iter_mut().zip(b.2) {
+                    *s += v;
+                }
+            }
+        }
+        drop(bands);
+        // A colour that only lines the edges of others (the greys of
+        // anti-aliasing between black ink and white paper) is a mix, not an
+        // ink: a palette colour must fill patches of its own.
+        let min_interior = ((w * h) as u64 / 2000).max(1);
+        let mut bins: Vec<(u64, [f32; 3])> = hist
+            .iter()
+            .filter(|(n, interior, _)| *n > 0 && *interior >= min_interior)
+            .map(|(n, _, s)| (*n, [0, 1, 2].map(|k| (s[k] / *n as f64) as f32)))
+            .collect();
+        bins.sort_by(|a, b| {
+            b.0.cmp(&a.0)
+                .then(a.1.partial_cmp(&b.1).unwrap_or(std::cmp::Ordering::Equal))
+        });
+        let min_count = ((w * h) as u64 / 500).max(1);
+        let mut palette: Vec<[f32; 3]> = Vec::new();
+        for (n, c) in &bins {
+            if *n < min_count || palette.len() >= 8 {
+                break;
+            }
+            if palette.iter().all(|p| dist2(p, c) > 48.0 * 48.0) {
+                palette.push(*c);
+            }
+        }
+        // Paper: the most common colour on the border (white if none).
+        // (The border's pixels only: the top and bottom rows and the first
+        // and last columns between them, each pixel once.)
+        let mut border = vec![0usize; 1 << 12];
+        let top_bottom = if h > 1 { vec![0, h - 1] } else { vec![0] };
+        let sides = if w > 1 { vec![0, w - 1] } else { vec![0] };
+        let rows = top_bottom
+            .iter()
+            .flat_map(|&y| (0..w).map(move |x| y * w + x));
+        let columns = (1..h.saturating_sub(1)).flat_map(|y| sides.iter().map(move |&x| y * w + x));
+        for i in rows.chain(columns) {
+            if let Some(n) = keys.get(i).and_then(|&k| border.get_mut(usize::from(k))) {
+                *n += 1;
+            }
+        }
+        let paper_key = border
+            .iter()
+            .enumerate()
+            .filter(|(_, &n)| n > 0)
+            .max_by_key(|(k, &n)| (n, std::cmp::Reverse(*k)))
+            .map(|(k, _)| k as u32);
+        let paper = palette
+            .iter()
+            .position(|p| Some(colour_key(p)) == paper_key)
+            .or_else(|| {
+                palette
+                    .iter()
+                    .position(|p| dist2(p, &[255.0; 3]) < 48.0 * 48.0)
+            });
+        let paper_colour = paper.map(|i| palette[i]).unwrap_or([255.0; 3]);
+        if let Some(i) = paper {
+            palette.remove(i);
+        }
+        palette.insert(0, paper_colour);
+        if paper_only {
+            palette.truncate(1);
+        }
+        let k = palette.len();
+        // The pairs (a ≤ b) with their difference and its squared length,
+        // computed once.
+        let pairs = (0..k)
+            .flat_map(|a| (a..k).map(move |b| (a, b)))
+            .map(|(a, b)| {
+                let (pa, pb) = (&palette[a], &palette[b]);
+                let d = [0, 1, 2].map(|j| pa[j] - pb[j]);
+                let dd: f32 = d.iter().map(|v| v * v).sum();
+                (a, b, d, dd)
+            })
+            .collect();
+        Palette {
+            colours: palette,
+            pairs,
+            has_alpha,
+        }
+    }
+
+    /// Pixel `p` as a mix of its two nearest palette colours `(a, b, t)`:
+    /// `t` of colour `a` and `1 − t` of colour `b` (`a ≤ b`), the mix
+    /// nearest to the pixel's colour over all pairs.
+    fn mix(&self, p: &[u8; 4]) -> (usize, usize, f32) {
+        let c = composite(p, self.has_alpha);
+        let mut best = (f32::MAX, 0usize, 0usize, 1.0f32);
+        for &(a, b, d, dd) in &self.pairs {
+            let pb = &self.colours[b];
+            let t = if dd > 0.0 {
+                (((0..3).map(|j| (c[j] - pb[j]) * d[j]).sum::<f32>()) / dd).clamp(0.0, 1.0)
+            } else {
+                1.0
+            };
+            let mix = [0, 1, 2].map(|j| pb[j] + t * d[j]);
+            let e = dist2(&mix, &c);
+            if e < best.0 {
+                best = (e, a, b, t);
+            }
+        }
+        (best.1, best.2, best.3)
+    }
+
+    /// Calls `each(i, mix)` for every pixel `i` of rows `rows` of the
+    /// `w`-wide `px`, in order. A pixel's mix depends on its value alone,
+    /// so it is looked up in a small table of the values met last (flat
+    /// art repeats a few values, a scan's noisy paper a few thousand)
+    /// before it is worked out.
+    fn mixes(
+        &self,
+        px: &[[u8; 4]],
+        w: usize,
+        rows: std::ops::Range<usize>,
+        each: &mut dyn FnMut(usize, (usize, usize, f32)),
+    ) {
+        const CACHE: usize = 1 << 12;
+        let mut cache = vec![(0u32, false, (0usize, 0usize, 0f32)); CACHE];
+        for y in rows {
+            for (x, p) in px[y * w..(y + 1) * w].iter().enumerate() {
+                let v = u32::from_le_bytes(*p);
+                let slot = (v.wrapping_mul(0x9e37_79b1) >> 20) as usize % CACHE;
+                let mix = match cache[slot] {
+                    (cv, true, mix) if cv == v => mix,
+                    _ => {
+                        let mix = self.mix(p);
+                        cache[slot] = (v, true, mix);
+                        mix
+                    }
+                };
+                each(y * w + x, mix);
+            }
+        }
+    }
+
+    /// Palette colour `k` as an output colour.
+    fn colour(&self, k: usize) -> Color {
+        let c = self.colours[k];
+        Color::rgb(c[0].round() as u8, c[1].round() as u8, c[2].round() as u8)
+    }
+}
+
+/// An RGBA pixel composited over white (transparency reads as paper),
+/// RGB 0..=255.
+fn composite(p: &[u8; 4], has_alpha: bool) -> [f32; 3] {
+    let a = if has_alpha { p[3] as f32 / 255.0 } else { 1.0 };
+    [0, 1, 2].map(|k| p[k] as f32 * a + 255.0 * (1.0 - a))
+}
+
+/// Rows per band of the per-pixel passes.
+const MIX_ROWS: usize = 16;
+
 /// Splits a colour raster into stacked layers: a palette of dominant colours
 /// (the paper colour, most common on the border, excluded), each pixel
 /// explained as a mix of its two nearest palette colours (anti-aliasing),
@@ -542,179 +837,9 @@ fn quantized_layers(
     invert: bool,
     union_only: bool,
 ) -> Vec<(Color, Coverage)> {
-    // Composite over white so transparency reads as paper.
-    let rgb = |p: &[u8; 4]| -> [f32; 3] {
-        let a = if has_alpha { p[3] as f32 / 255.0 } else { 1.0 };
-        [0, 1, 2].map(|k| p[k] as f32 * a + 255.0 * (1.0 - a))
-    };
-    let key =
-        |c: &[f32; 3]| ((c[0] as u32 >> 4) << 8) | ((c[1] as u32 >> 4) << 4) | (c[2] as u32 >> 4);
-    let keys: Vec<u16> = px.par_iter().map(|p| key(&rgb(p)) as u16).collect();
+    let palette = Palette::of(px, w, h, has_alpha, invert);
+    let k = palette.colours.len();
     let w1 = w.max(1);
-    // Per colour bin: pixels, pixels inside a patch of the colour (their
-    // four neighbours in the same bin), and the sum of the colours.
-    // (Keys are 12 bits: one slot per key, visited in key order.) Bands
-    // of rows are counted in parallel and added up in order, so the sums
-    // do not depend on the thread count.
-    type Bin = (u64, u64, [f64; 3]);
-    const BAND: usize = 64;
-    let bands: Vec<Vec<Bin>> = (0..h.div_ceil(BAND))
-        .into_par_iter()
-        .map(|band| {
-            let mut hist: Vec<Bin> = vec![(0, 0, [0.0; 3]); 1 << 12];
-            for y in band * BAND..((band + 1) * BAND).min(h) {
-                let row = y * w;
-                for x in 0..w {
-                    let i = row + x;
-                    let k = keys[i];
-                    let interior = x > 0
-                        && y > 0
-                        && x + 1 < w
-                        && y + 1 < h
-                        && keys[i - 1] == k
-                        && keys[i + 1] == k
-                        && keys[i - w] == k
-                        && keys[i + w] == k;
-                    let Some(e) = hist.get_mut(usize::from(k)) else {
-                        continue;
-                    };
-                    e.0 += 1;
-                    e.1 += u64::from(interior);
-                    for (sum, v) in e.2.iter_mut().zip(rgb(&px[i])) {
-                        *sum += v as f64;
-                    }
-                }
-            }
-            hist
-        })
-        .collect();
-    let mut hist: Vec<Bin> = vec![(0, 0, [0.0; 3]); 1 << 12];
-    for band in &bands {
-        for (e, b) in hist.iter_mut().zip(band) {
-            e.0 += b.0;
-            e.1 += b.1;
-            for (s, v) in e.2.iter_mut().zip(b.2) {
-                *s += v;
-            }
-        }
-    }
-    drop(bands);
-    // A colour that only lines the edges of others (the greys of
-    // anti-aliasing between black ink and white paper) is a mix, not an
-    // ink: a palette colour must fill patches of its own.
-    let min_interior = ((w * h) as u64 / 2000).max(1);
-    let mut bins: Vec<(u64, [f32; 3])> = hist
-        .iter()
-        .filter(|(n, interior, _)| *n > 0 && *interior >= min_interior)
-        .map(|(n, _, s)| (*n, [0, 1, 2].map(|k| (s[k] / *n as f64) as f32)))
-        .collect();
-    bins.sort_by(|a, b| {
-        b.0.cmp(&a.0)
-            .then(a.1.partial_cmp(&b.1).unwrap_or(std::cmp::Ordering::Equal))
-    });
-    let min_count = ((w * h) as u64 / 500).max(1);
-    let dist2 = |a: &[f32; 3], b: &[f32; 3]| (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f32>();
-    let mut palette: Vec<[f32; 3]> = Vec::new();
-    for (n, c) in &bins {
-        if *n < min_count || palette.len() >= 8 {
-            break;
-        }
-        if palette.iter().all(|p| dist2(p, c) > 48.0 * 48.0) {
-            palette.push(*c);
-        }
-    }
-    // Paper: the most common colour on the border (white if none).
-    // (The border's pixels only: the top and bottom rows and the first
-    // and last columns between them, each pixel once.)
-    let mut border = vec![0usize; 1 << 12];
-    let top_bottom = if h > 1 { vec![0, h - 1] } else { vec![0] };
-    let sides = if w > 1 { vec![0, w - 1] } else { vec![0] };
-    let rows = top_bottom
-        .iter()
-        .flat_map(|&y| (0..w).map(move |x| y * w + x));
-    let columns = (1..h.saturating_sub(1)).flat_map(|y| sides.iter().map(move |&x| y * w + x));
-    for i in rows.chain(columns) {
-        if let Some(n) = keys.get(i).and_then(|&k| border.get_mut(usize::from(k))) {
-            *n += 1;
-        }
-    }
-    let paper_key = border
-        .iter()
-        .enumerate()
-        .filter(|(_, &n)| n > 0)
-        .max_by_key(|(k, &n)| (n, std::cmp::Reverse(*k)))
-        .map(|(k, _)| k as u32);
-    let paper = palette
-        .iter()
-        .position(|p| Some(key(p)) == paper_key)
-        .or_else(|| {
-            palette
-                .iter()
-                .position(|p| dist2(p, &[255.0; 3]) < 48.0 * 48.0)
-        });
-    let paper_colour = paper.map(|i| palette[i]).unwrap_or([255.0; 3]);
-    if let Some(i) = paper {
-        palette.remove(i);
-    }
-    palette.insert(0, paper_colour);
-    if invert {
-        // Inverting swaps the roles: trace the paper as the only layer.
-        palette.truncate(1);
-    }
-    let k = palette.len();
-    // The pairs (a ≤ b) with their difference and its squared length,
-    // computed once.
-    let pairs: Vec<(usize, usize, [f32; 3], f32)> = (0..k)
-        .flat_map(|a| (a..k).map(move |b| (a, b)))
-        .map(|(a, b)| {
-            let (pa, pb) = (&palette[a], &palette[b]);
-            let d = [0, 1, 2].map(|j| pa[j] - pb[j]);
-            let dd: f32 = d.iter().map(|v| v * v).sum();
-            (a, b, d, dd)
-        })
-        .collect();
-    let nearest_mix = |c: &[f32; 3]| {
-        let mut best = (f32::MAX, 0usize, 0usize, 1.0f32);
-        for &(a, b, d, dd) in &pairs {
-            let pb = &palette[b];
-            let t = if dd > 0.0 {
-                (((0..3).map(|j| (c[j] - pb[j]) * d[j]).sum::<f32>()) / dd).clamp(0.0, 1.0)
-            } else {
-                1.0
-            };
-            let mix = [0, 1, 2].map(|j| pb[j] + t * d[j]);
-            let e = dist2(&mix, c);
-            if e < best.0 {
-                best = (e, a, b, t);
-            }
-        }
-        (best.1, best.2, best.3)
-    };
-    // Per pixel, the two nearest palette colours and the share of the
-    // first, `(a, b, t)`, rows in parallel. A pixel's mix depends on its
-    // value alone, so it is looked up in a small table of the values met
-    // last (flat art repeats a few values, a scan's noisy paper a few
-    // thousand) before it is worked out.
-    let mixes = |each: &mut dyn FnMut(usize, (usize, usize, f32)), rows: std::ops::Range<usize>| {
-        const CACHE: usize = 1 << 12;
-        let mut cache = vec![(0u32, false, (0usize, 0usize, 0f32)); CACHE];
-        for y in rows {
-            for (x, p) in px[y * w..(y + 1) * w].iter().enumerate() {
-                let v = u32::from_le_bytes(*p);
-                let slot = (v.wrapping_mul(0x9e37_79b1) >> 20) as usize % CACHE;
-                let mix = match cache[slot] {
-                    (cv, true, mix) if cv == v => mix,
-                    _ => {
-                        let mix = nearest_mix(&rgb(p));
-                        cache[slot] = (v, true, mix);
-                        mix
-                    }
-                };
-                each(y * w + x, mix);
-            }
-        }
-    };
-    const ROWS: usize = 16;
     if union_only && !invert {
         // Only the bottom of the stack (every ink), black; nothing when the
         // palette holds no ink. A pixel's ink is the share of its mix that
@@ -723,11 +848,14 @@ fn quantized_layers(
             return Vec::new();
         }
         let mut all = vec![0f32; w * h];
-        all.par_chunks_mut(ROWS * w1)
+        all.par_chunks_mut(MIX_ROWS * w1)
             .enumerate()
             .for_each(|(band, out)| {
-                let first = band * ROWS;
-                mixes(
+                let first = band * MIX_ROWS;
+                palette.mixes(
+                    px,
+                    w,
+                    first..(first + MIX_ROWS).min(h),
                     &mut |i, (a, b, t)| {
                         out[i - first * w] = if a >= 1 {
                             (t + (1.0 - t)).min(1.0)
@@ -737,7 +865,6 @@ fn quantized_layers(
                             0.0
                         };
                     },
-                    first..(first + ROWS).min(h),
                 )
             });
         return Grid::from_vec(w, h, all)
@@ -748,11 +875,14 @@ fn quantized_layers(
     // band of rows writes its own pixels' `k` weights).
     let mut weights = vec![0f32; w * h * k];
     weights
-        .par_chunks_mut((ROWS * k * w).max(1))
+        .par_chunks_mut((MIX_ROWS * k * w).max(1))
         .enumerate()
         .for_each(|(band, out)| {
-            let first = band * ROWS;
-            mixes(
+            let first = band * MIX_ROWS;
+            palette.mixes(
+                px,
+                w,
+                first..(first + MIX_ROWS).min(h),
                 &mut |i, (a, b, t)| {
                     let wt = &mut out[(i - first * w) * k..(i - first * w + 1) * k];
                     if let Some(x) = wt.get_mut(a) {
@@ -762,12 +892,11 @@ fn quantized_layers(
                         *x += 1.0 - t;
                     }
                 },
-                first..(first + ROWS).min(h),
             )
         });
     if invert {
         let cov = Grid::from_fn(w, h, |x, y| weights[(y * w + x) * k]);
-        let c = palette[0];
+        let c = palette.colours[0];
         return vec![(Color::rgb(c[0] as u8, c[1] as u8, c[2] as u8), cov)];
     }
     if union_only {
@@ -797,11 +926,7 @@ fn quantized_layers(
                     .collect(),
             )
             .unwrap_or_else(|| Grid::new(w, h, 0.0));
-            let c = palette[j];
-            (
-                Color::rgb(c[0].round() as u8, c[1].round() as u8, c[2].round() as u8),
-                cov,
-            )
+            (palette.colour(j), cov)
         })
         .collect()
 }
