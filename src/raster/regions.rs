@@ -429,12 +429,12 @@ pub fn boundaries(p: &Partition) -> Boundaries {
                 let joined = if total(l) >= total(m) { l } else { m };
                 // Each corner of the other colour is cut off by the piece
                 // from the edge before it to the edge after it.
-                for k in 0..4 {
-                    if c[k] == joined {
+                for (k, &corner) in c.iter().enumerate() {
+                    if corner == joined {
                         continue;
                     }
                     let (e_in, e_out) = ((k + 3) % 4, k);
-                    let (left, right) = (c[k], joined);
+                    let (left, right) = (corner, joined);
                     let (from, to, left, right) = if left < right {
                         (edges[e_in], edges[e_out], left, right)
                     } else {
