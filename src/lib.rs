@@ -403,6 +403,19 @@ impl Image {
             picture: read::ink::read_traceable(bytes, opts)?,
         })
     }
+
+    /// Reads raster or SVG bytes as the regions of their colours, the
+    /// paper's too, for a cut-out trace (`--layers --cutout`): [`trace()`]
+    /// then makes each region a closed shape of its own colour, and
+    /// neighbouring regions share exactly the same boundary curves, so
+    /// they cover the picture with no gap and no overlap. A raster is read
+    /// at its own size, an SVG rendered at `opts.resolution`; `opts.invert`
+    /// is refused.
+    pub fn regions_from_bytes(bytes: &[u8], opts: &ImageOptions) -> Result<Image> {
+        Ok(Image {
+            picture: read::ink::Traceable::Regions(read::ink::read_regions(bytes, opts)?),
+        })
+    }
 }
 
 /// Traces a picture's ink into compact filled Bézier outlines, one

@@ -247,6 +247,11 @@ struct TraceArgs {
     /// Trace each fill colour separately and stack the layers.
     #[arg(long)]
     layers: bool,
+    /// With --layers: each colour's region (the paper's too) a shape of
+    /// its own, neighbours sharing exactly the same boundary curves, so
+    /// nothing overlaps and no seam shows (cutting plotters, embroidery).
+    #[arg(long, requires = "layers", conflicts_with = "invert")]
+    cutout: bool,
 }
 
 #[derive(Args)]
@@ -396,7 +401,12 @@ fn run_trace(args: TraceArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
     input.validate()?;
     let job = |inp: &Path| -> Result<String, Error> {
         let bytes = io::read_input(inp)?;
-        let out = Image::from_bytes(&bytes, &input)
+        let image = if args.cutout {
+            Image::regions_from_bytes(&bytes, &input)
+        } else {
+            Image::from_bytes(&bytes, &input)
+        };
+        let out = image
             .and_then(|image| flourish::trace(&image, &opts))
             .map_err(|e| e.in_file(shown(inp)))?;
         Ok(report(inp, out, quiet, verbose))

@@ -19,7 +19,10 @@
 //!   exemplars', line thicknesses closer to the exemplars' than half the
 //!   art brush's distance.
 //! - trace: the render of the output matches the drawing's own render
-//!   (IoU of the ink at the bitmap's size).
+//!   (IoU of the ink at the bitmap's size); a drawing in several colours,
+//!   traced `--layers --cutout` too and rendered at 4× without
+//!   anti-aliasing, leaves no pixel uncovered (`cutout-gaps`) and none
+//!   covered twice (`cutout-overlaps`).
 
 use crate::brush::measure::{ink, ExemplarFigures, Fidelity};
 use crate::brush::output::brush_sketch;
@@ -744,5 +747,14 @@ fn trace(input: &Path) -> Outcome {
             wanted: "(recorded: the scan is turned)".into(),
         }
     });
+    if read.layers {
+        // The same colours cut out: rendered at 4x without anti-aliasing,
+        // no pixel left uncovered and none covered twice.
+        let cut = crate::Image::regions_from_bytes(&bytes, &read)?;
+        let cut = crate::trace(&cut, &crate::TraceOptions::default())?;
+        let (gaps, overlaps) = crate::trace::cutout::measure::gaps_and_overlaps(&cut.document, 4.0);
+        checks.push(Check::at_most("cutout-gaps", gaps as f64, 0.0));
+        checks.push(Check::at_most("cutout-overlaps", overlaps as f64, 0.0));
+    }
     Ok((svg, checks))
 }

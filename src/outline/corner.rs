@@ -61,19 +61,28 @@ pub fn corners(pts: &[Point]) -> Vec<usize> {
         let t = if seg > 0.0 { (s - cum[i]) / seg } else { 0.0 };
         pts[i].lerp(pts[(i + 1) % n], t)
     };
+    // How far a circle as long as the loop turns between the chords to
+    // the points a window before and after each of its points.
+    let round = std::f64::consts::TAU * CORNER_WINDOW / total;
+    let threshold = CORNER_ANGLE.max(round + EXCESS);
+    // A vertex whose chords meet at an angle clearly under the threshold
+    // (their cosine above its cosine, with a margin far beyond rounding)
+    // is no corner and no rival of one: its turning is left at 0, and
+    // only the others pay for the angle itself.
+    let clearly_under = (threshold - 1e-6).max(0.0).cos();
     let (mut behind, mut ahead) = (0usize, 0usize);
     let turn: Vec<f64> = (0..n)
         .map(|i| {
             let p = pts[i];
             let a = p - at(cum[i] - CORNER_WINDOW, &mut behind);
             let b = at(cum[i] + CORNER_WINDOW, &mut ahead) - p;
-            a.cross(b).atan2(a.dot(b)).abs()
+            let dot = a.dot(b);
+            if dot > clearly_under * (a.hypot2() * b.hypot2()).sqrt() {
+                return 0.0;
+            }
+            a.cross(b).atan2(dot).abs()
         })
         .collect();
-    // How far a circle as long as the loop turns between the chords to
-    // the points a window before and after each of its points.
-    let round = std::f64::consts::TAU * CORNER_WINDOW / total;
-    let threshold = CORNER_ANGLE.max(round + EXCESS);
     let mut out = Vec::new();
     for i in 0..n {
         if turn[i] < threshold {

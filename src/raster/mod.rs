@@ -6,6 +6,7 @@ pub mod bitmap;
 pub mod contour;
 pub mod edt;
 pub mod plain;
+pub mod regions;
 pub mod scan;
 pub mod sdf;
 pub mod vector;
@@ -127,6 +128,20 @@ impl Grid<f32> {
     }
 }
 
+/// `x` (finite, at least 0) rounded to the nearest integer, halves away
+/// from zero, as `f32::round` does, without the library call that the
+/// baseline x86-64 instruction set needs for it (the difference from the
+/// truncation is exact for such `x`).
+#[inline]
+pub fn round_positive(x: f32) -> f32 {
+    let t = x as i64 as f32;
+    if x - t >= 0.5 {
+        t + 1.0
+    } else {
+        t
+    }
+}
+
 /// Ink coverage of one layer: 0 (paper) to 1 (ink) per pixel, anti-aliased
 /// edges kept as fractional coverage.
 pub type Coverage = Grid<f32>;
@@ -135,4 +150,24 @@ pub type Coverage = Grid<f32>;
 /// whose edge lies anywhere within half a pixel of its staircase.
 pub fn is_binary(cov: &Coverage) -> bool {
     cov.data().iter().all(|&c| c == 0.0 || c == 1.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// The rounding without the library call is `f32::round` on every
+        /// non-negative value up to past where floats are all integers,
+        /// halves and their neighbours included.
+        #[test]
+        fn round_positive_is_round(x in 0.0f32..2e7, k in 0u32..70_000) {
+            prop_assert_eq!(round_positive(x), x.round());
+            let half = k as f32 + 0.5;
+            for v in [half, f32::from_bits(half.to_bits() - 1), f32::from_bits(half.to_bits() + 1)] {
+                prop_assert_eq!(round_positive(v), v.round());
+            }
+        }
+    }
 }

@@ -312,7 +312,26 @@ fn edge_model(cov: &Coverage, x: i32, y: i32) -> Option<EdgeModel> {
     if !(c > COVERAGE_EPS && c < 1.0 - COVERAGE_EPS) {
         return None;
     }
-    let at = |dx: i32, dy: i32| cov.get_or((x + dx) as isize, (y + dy) as isize, 0.0) as f64;
+    // The 3×3 neighbourhood (paper outside the grid), read by row slices
+    // away from the border.
+    let (w, h) = (cov.width() as i32, cov.height() as i32);
+    let mut near = [[0f64; 3]; 3];
+    if x >= 1 && y >= 1 && x + 1 < w && y + 1 < h {
+        let data = cov.data();
+        for (r, dy) in near.iter_mut().zip(-1..=1) {
+            let i = ((y + dy) * w + x - 1) as usize;
+            if let Some(row) = data.get(i..i + 3) {
+                *r = [row[0] as f64, row[1] as f64, row[2] as f64];
+            }
+        }
+    } else {
+        for (r, dy) in near.iter_mut().zip(-1..=1) {
+            for (v, dx) in r.iter_mut().zip(-1..=1) {
+                *v = cov.get_or((x + dx) as isize, (y + dy) as isize, 0.0) as f64;
+            }
+        }
+    }
+    let at = |dx: i32, dy: i32| near[(dy + 1) as usize][(dx + 1) as usize];
     // Isotropic 3×3 gradient (weights 1, √2, 1).
     let r2 = std::f64::consts::SQRT_2;
     let gx = at(1, -1) + r2 * at(1, 0) + at(1, 1) - at(-1, -1) - r2 * at(-1, 0) - at(-1, 1);

@@ -8,6 +8,7 @@ use super::ImageOptions;
 use crate::error::{Error, Result};
 use crate::io;
 use crate::outline::paths::Bitmap;
+use crate::raster::regions::Partition;
 use crate::raster::{Coverage, Grid};
 use crate::svg_out::Color;
 use rayon::prelude::*;
@@ -69,26 +70,49 @@ pub(super) fn raster_coverage(
     opts: &ImageOptions,
 ) -> Result<(RasterCoverage, Option<Lighting>)> {
     let img = decode_raster(bytes)?;
-    if let (image::DynamicImage::ImageLuma8(grey), false) = (&img, opts.layers) {
+    // A grey picture, stored as grey or as colour with three equal
+    // channels (a scan saved as RGB), is read by its 256 levels.
+    let grey = match (&img, opts.layers) {
+        (image::DynamicImage::ImageLuma8(grey), false) => Some(std::borrow::Cow::Borrowed(grey)),
+        (image::DynamicImage::ImageRgb8(rgb), false) => {
+            grey_of_rgb(rgb).map(std::borrow::Cow::Owned)
+        }
+        _ => None,
+    };
+    if let Some(grey) = grey {
         let (w, h) = (grey.width() as usize, grey.height() as usize);
         // A photo's uneven light divided out first (see `lighting`).
         let raw = grey.as_raw();
         let luma = |x: usize, y: usize| raw.get(y * w + x).copied().unwrap_or(255);
         if let Some(light) = Lighting::measure(w, h, luma) {
-            let mut even = grey.clone();
+            let mut even = grey.into_owned();
             light.flatten_grey(&mut even);
             return Ok((grey_coverage(&even, opts.invert), Some(light)));
         }
-        return Ok((grey_coverage(grey, opts.invert), None));
+        return Ok((grey_coverage(&grey, opts.invert), None));
     }
-    let img = img.to_rgba8();
     let (w, h) = (img.width() as usize, img.height() as usize);
-    let mut px: Vec<[u8; 4]> = img.pixels().map(|p| p.0).collect();
+    // RGBA pixels, read straight from the decoder's colour bytes where it
+    // holds 8-bit RGB or RGBA (one copy), else converted.
+    let mut px: Vec<[u8; 4]> = match img {
+        image::DynamicImage::ImageRgb8(rgb) => rgb
+            .as_raw()
+            .chunks_exact(3)
+            .map(|c| [c[0], c[1], c[2], 255])
+            .collect(),
+        image::DynamicImage::ImageRgba8(rgba) => rgba
+            .as_raw()
+            .chunks_exact(4)
+            .map(|c| [c[0], c[1], c[2], c[3]])
+            .collect(),
+        other => other.to_rgba8().pixels().map(|p| p.0).collect(),
+    };
     let mut lighting = None;
     if px.iter().all(|p| p[3] == 255) {
         let at = |x: usize, y: usize| {
-            px.get(y * w + x)
-                .map_or(255, |p| (luma(p) * 255.0).round() as u8)
+            px.get(y * w + x).map_or(255, |p| {
+                crate::raster::round_positive(luma(p) * 255.0) as u8
+            })
         };
         lighting = Lighting::measure(w, h, at);
         if let Some(light) = &lighting {
@@ -96,6 +120,87 @@ pub(super) fn raster_coverage(
         }
     }
     Ok((pixel_coverage(&px, w, h, opts), lighting))
+}
+
+/// A raster's pixels read as regions of its palette's colours (see
+/// [`crate::raster::regions`]): the partition and each colour, the
+/// paper's first; with the uneven light of a photo divided out first, as
+/// for the layers.
+pub(super) fn raster_partition(bytes: &[u8]) -> Result<(Partition, Vec<Color>, Option<Lighting>)> {
+    let img = decode_raster(bytes)?;
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    let mut px: Vec<[u8; 4]> = match img {
+        image::DynamicImage::ImageRgb8(rgb) => rgb
+            .as_raw()
+            .chunks_exact(3)
+            .map(|c| [c[0], c[1], c[2], 255])
+            .collect(),
+        image::DynamicImage::ImageRgba8(rgba) => rgba
+            .as_raw()
+            .chunks_exact(4)
+            .map(|c| [c[0], c[1], c[2], c[3]])
+            .collect(),
+        other => other.to_rgba8().pixels().map(|p| p.0).collect(),
+    };
+    let mut lighting = None;
+    if px.iter().all(|p| p[3] == 255) {
+        let at = |x: usize, y: usize| {
+            px.get(y * w + x).map_or(255, |p| {
+                crate::raster::round_positive(luma(p) * 255.0) as u8
+            })
+        };
+        lighting = Lighting::measure(w, h, at);
+        if let Some(light) = &lighting {
+            light.flatten_rgba(&mut px);
+        }
+    }
+    let (partition, colours) = pixel_partition(&px, w, h)?;
+    Ok((partition, colours, lighting))
+}
+
+/// `w` × `h` RGBA pixels as regions of their palette's colours, with the
+/// colours (the paper's first).
+pub(super) fn pixel_partition(
+    px: &[[u8; 4]],
+    w: usize,
+    h: usize,
+) -> Result<(Partition, Vec<Color>)> {
+    let has_alpha = px.iter().any(|p| p[3] < 255);
+    let palette = Palette::of(px, w, h, has_alpha, false);
+    let mut mixes = vec![(0u8, 0u8, 1f32); w * h];
+    mixes
+        .par_chunks_mut((MIX_ROWS * w).max(1))
+        .enumerate()
+        .for_each(|(band, out)| {
+            let first = band * MIX_ROWS;
+            palette.mixes(
+                px,
+                w,
+                first..(first + MIX_ROWS).min(h),
+                &mut |i, (a, b, t)| {
+                    out[i - first * w] = (a as u8, b as u8, t);
+                },
+            )
+        });
+    let k = palette.colours.len();
+    let colours = (0..k).map(|j| palette.colour(j)).collect();
+    let partition = Partition::new(w, h, k, mixes)
+        .ok_or_else(|| Error::invalid("the picture's colours do not make a partition"))?;
+    Ok((partition, colours))
+}
+
+/// `rgb` as a grey image when every pixel's three channels are equal,
+/// else `None` (found at the first coloured pixel).
+fn grey_of_rgb(rgb: &image::RgbImage) -> Option<image::GrayImage> {
+    let raw = rgb.as_raw();
+    let mut grey = Vec::with_capacity(raw.len() / 3);
+    for c in raw.chunks_exact(3) {
+        if c[0] != c[1] || c[1] != c[2] {
+            return None;
+        }
+        grey.push(c[0]);
+    }
+    image::GrayImage::from_raw(rgb.width(), rgb.height(), grey)
 }
 
 /// The ink coverage of `w` × `h` RGBA pixels (not premultiplied), row by
@@ -374,7 +479,8 @@ impl InkScale {
 
     /// The scale of raw coverage values in 0..=1 (binned by 1/255).
     fn of_values(raw: &[f32]) -> InkScale {
-        let bin = |c: f32| ((c.clamp(0.0, 1.0) * 255.0).round() as usize).min(255);
+        let bin =
+            |c: f32| (crate::raster::round_positive(c.clamp(0.0, 1.0) * 255.0) as usize).min(255);
         let (counts, top) = raw
             .par_chunks(1 << 16)
             .map(|chunk| {
@@ -492,6 +598,233 @@ fn mean_ink_colour(px: &[[u8; 4]], cov: &Coverage) -> Color {
     Color::rgb((sum[0] / n) as u8, (sum[1] / n) as u8, (sum[2] / n) as u8)
 }
 
+/// A colour raster's palette of dominant colours, the paper's first (the
+/// most common colour on the border, white when none), and how each
+/// pixel is read as a mix of two of them.
+struct Palette {
+    /// Colours (RGB, 0..=255), the paper's first.
+    colours: Vec<[f32; 3]>,
+    /// Pairs `(a ≤ b)` of palette indices with the difference of their
+    /// colours and its squared length.
+    pairs: Vec<(usize, usize, [f32; 3], f32)>,
+    has_alpha: bool,
+}
+
+/// Squared distance between two RGB colours.
+fn dist2(a: &[f32; 3], b: &[f32; 3]) -> f32 {
+    (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f32>()
+}
+
+/// The 12-bit histogram key of an RGB colour (4 bits a channel).
+fn colour_key(c: &[f32; 3]) -> u32 {
+    ((c[0] as u32 >> 4) << 8) | ((c[1] as u32 >> 4) << 4) | (c[2] as u32 >> 4)
+}
+
+impl Palette {
+    /// The palette of `w` × `h` RGBA pixels (see [`quantized_layers`]):
+    /// colours that fill patches of their own, most common first, at
+    /// least 48 levels apart, at most 8, the paper moved to the front;
+    /// only the paper with `paper_only`.
+    fn of(px: &[[u8; 4]], w: usize, h: usize, has_alpha: bool, paper_only: bool) -> Palette {
+        let rgb = |p: &[u8; 4]| composite(p, has_alpha);
+        let keys: Vec<u16> = px.par_iter().map(|p| colour_key(&rgb(p)) as u16).collect();
+        // Per colour bin: pixels, pixels inside a patch of the colour (their
+        // four neighbours in the same bin), and the sum of the colours.
+        // (Keys are 12 bits: one slot per key, visited in key order.) Bands
+        // of rows are counted in parallel and added up in order, so the sums
+        // do not depend on the thread count.
+        type Bin = (u64, u64, [f64; 3]);
+        const BAND: usize = 64;
+        let bands: Vec<Vec<Bin>> = (0..h.div_ceil(BAND))
+            .into_par_iter()
+            .map(|band| {
+                let mut hist: Vec<Bin> = vec![(0, 0, [0.0; 3]); 1 << 12];
+                for y in band * BAND..((band + 1) * BAND).min(h) {
+                    let row = y * w;
+                    for x in 0..w {
+                        let i = row + x;
+                        let k = keys[i];
+                        let interior = x > 0
+                            && y > 0
+                            && x + 1 < w
+                            && y + 1 < h
+                            && keys[i - 1] == k
+                            && keys[i + 1] == k
+                            && keys[i - w] == k
+                            && keys[i + w] == k;
+                        let Some(e) = hist.get_mut(usize::from(k)) else {
+                            continue;
+                        };
+                        e.0 += 1;
+                        e.1 += u64::from(interior);
+                        for (sum, v) in e.2.iter_mut().zip(rgb(&px[i])) {
+                            *sum += v as f64;
+                        }
+                    }
+                }
+                hist
+            })
+            .collect();
+        let mut hist: Vec<Bin> = vec![(0, 0, [0.0; 3]); 1 << 12];
+        for band in &bands {
+            for (e, b) in hist.iter_mut().zip(band) {
+                e.0 += b.0;
+                e.1 += b.1;
+                for (s, v) in e.2.iter_mut().zip(b.2) {
+                    *s += v;
+                }
+            }
+        }
+        drop(bands);
+        // A colour that only lines the edges of others (the greys of
+        // anti-aliasing between black ink and white paper) is a mix, not an
+        // ink: a palette colour must fill patches of its own.
+        let min_interior = ((w * h) as u64 / 2000).max(1);
+        let mut bins: Vec<(u64, [f32; 3])> = hist
+            .iter()
+            .filter(|(n, interior, _)| *n > 0 && *interior >= min_interior)
+            .map(|(n, _, s)| (*n, [0, 1, 2].map(|k| (s[k] / *n as f64) as f32)))
+            .collect();
+        bins.sort_by(|a, b| {
+            b.0.cmp(&a.0)
+                .then(a.1.partial_cmp(&b.1).unwrap_or(std::cmp::Ordering::Equal))
+        });
+        let min_count = ((w * h) as u64 / 500).max(1);
+        let mut palette: Vec<[f32; 3]> = Vec::new();
+        for (n, c) in &bins {
+            if *n < min_count || palette.len() >= 8 {
+                break;
+            }
+            if palette.iter().all(|p| dist2(p, c) > 48.0 * 48.0) {
+                palette.push(*c);
+            }
+        }
+        // Paper: the most common colour on the border (white if none).
+        // (The border's pixels only: the top and bottom rows and the first
+        // and last columns between them, each pixel once.)
+        let mut border = vec![0usize; 1 << 12];
+        let top_bottom = if h > 1 { vec![0, h - 1] } else { vec![0] };
+        let sides = if w > 1 { vec![0, w - 1] } else { vec![0] };
+        let rows = top_bottom
+            .iter()
+            .flat_map(|&y| (0..w).map(move |x| y * w + x));
+        let columns = (1..h.saturating_sub(1)).flat_map(|y| sides.iter().map(move |&x| y * w + x));
+        for i in rows.chain(columns) {
+            if let Some(n) = keys.get(i).and_then(|&k| border.get_mut(usize::from(k))) {
+                *n += 1;
+            }
+        }
+        let paper_key = border
+            .iter()
+            .enumerate()
+            .filter(|(_, &n)| n > 0)
+            .max_by_key(|(k, &n)| (n, std::cmp::Reverse(*k)))
+            .map(|(k, _)| k as u32);
+        let paper = palette
+            .iter()
+            .position(|p| Some(colour_key(p)) == paper_key)
+            .or_else(|| {
+                palette
+                    .iter()
+                    .position(|p| dist2(p, &[255.0; 3]) < 48.0 * 48.0)
+            });
+        let paper_colour = paper.map(|i| palette[i]).unwrap_or([255.0; 3]);
+        if let Some(i) = paper {
+            palette.remove(i);
+        }
+        palette.insert(0, paper_colour);
+        if paper_only {
+            palette.truncate(1);
+        }
+        let k = palette.len();
+        // The pairs (a ≤ b) with their difference and its squared length,
+        // computed once.
+        let pairs = (0..k)
+            .flat_map(|a| (a..k).map(move |b| (a, b)))
+            .map(|(a, b)| {
+                let (pa, pb) = (&palette[a], &palette[b]);
+                let d = [0, 1, 2].map(|j| pa[j] - pb[j]);
+                let dd: f32 = d.iter().map(|v| v * v).sum();
+                (a, b, d, dd)
+            })
+            .collect();
+        Palette {
+            colours: palette,
+            pairs,
+            has_alpha,
+        }
+    }
+
+    /// Pixel `p` as a mix of its two nearest palette colours `(a, b, t)`:
+    /// `t` of colour `a` and `1 − t` of colour `b` (`a ≤ b`), the mix
+    /// nearest to the pixel's colour over all pairs.
+    fn mix(&self, p: &[u8; 4]) -> (usize, usize, f32) {
+        let c = composite(p, self.has_alpha);
+        let mut best = (f32::MAX, 0usize, 0usize, 1.0f32);
+        for &(a, b, d, dd) in &self.pairs {
+            let pb = &self.colours[b];
+            let t = if dd > 0.0 {
+                (((0..3).map(|j| (c[j] - pb[j]) * d[j]).sum::<f32>()) / dd).clamp(0.0, 1.0)
+            } else {
+                1.0
+            };
+            let mix = [0, 1, 2].map(|j| pb[j] + t * d[j]);
+            let e = dist2(&mix, &c);
+            if e < best.0 {
+                best = (e, a, b, t);
+            }
+        }
+        (best.1, best.2, best.3)
+    }
+
+    /// Calls `each(i, mix)` for every pixel `i` of rows `rows` of the
+    /// `w`-wide `px`, in order. A pixel's mix depends on its value alone,
+    /// so it is looked up in a small table of the values met last (flat
+    /// art repeats a few values, a scan's noisy paper a few thousand)
+    /// before it is worked out.
+    fn mixes(
+        &self,
+        px: &[[u8; 4]],
+        w: usize,
+        rows: std::ops::Range<usize>,
+        each: &mut dyn FnMut(usize, (usize, usize, f32)),
+    ) {
+        const CACHE: usize = 1 << 12;
+        let mut cache = vec![(0u32, false, (0usize, 0usize, 0f32)); CACHE];
+        for y in rows {
+            for (x, p) in px[y * w..(y + 1) * w].iter().enumerate() {
+                let v = u32::from_le_bytes(*p);
+                let slot = (v.wrapping_mul(0x9e37_79b1) >> 20) as usize % CACHE;
+                let mix = match cache[slot] {
+                    (cv, true, mix) if cv == v => mix,
+                    _ => {
+                        let mix = self.mix(p);
+                        cache[slot] = (v, true, mix);
+                        mix
+                    }
+                };
+                each(y * w + x, mix);
+            }
+        }
+    }
+
+    /// Palette colour `k` as an output colour.
+    fn colour(&self, k: usize) -> Color {
+        let c = self.colours[k];
+        Color::rgb(c[0].round() as u8, c[1].round() as u8, c[2].round() as u8)
+    }
+}
+
+/// An RGBA pixel composited over white (transparency reads as paper),
+/// RGB 0..=255.
+fn composite(p: &[u8; 4], has_alpha: bool) -> [f32; 3] {
+    let a = if has_alpha { p[3] as f32 / 255.0 } else { 1.0 };
+    [0, 1, 2].map(|k| p[k] as f32 * a + 255.0 * (1.0 - a))
+}
+
+/// Rows per band of the per-pixel passes.
+const MIX_ROWS: usize = 16;
+
 /// Splits a colour raster into stacked layers: a palette of dominant colours
 /// (the paper colour, most common on the border, excluded), each pixel
 /// explained as a mix of its two nearest palette colours (anti-aliasing),
@@ -504,176 +837,79 @@ fn quantized_layers(
     invert: bool,
     union_only: bool,
 ) -> Vec<(Color, Coverage)> {
-    // Composite over white so transparency reads as paper.
-    let rgb: Vec<[f32; 3]> = px
-        .iter()
-        .map(|p| {
-            let a = if has_alpha { p[3] as f32 / 255.0 } else { 1.0 };
-            [0, 1, 2].map(|k| p[k] as f32 * a + 255.0 * (1.0 - a))
-        })
-        .collect();
-    let key =
-        |c: &[f32; 3]| ((c[0] as u32 >> 4) << 8) | ((c[1] as u32 >> 4) << 4) | (c[2] as u32 >> 4);
-    let keys: Vec<u32> = rgb.iter().map(key).collect();
-    // Per colour bin: pixels, pixels inside a patch of the colour (their
-    // four neighbours in the same bin), and the sum of the colours.
-    // (Keys are 12 bits: one slot per key, visited in key order.)
-    let mut hist = vec![(0u64, 0u64, [0f64; 3]); 1 << 12];
-    for (i, c) in rgb.iter().enumerate() {
-        let (x, y) = (i % w, i / w);
-        let k = keys[i];
-        let interior = x > 0
-            && y > 0
-            && x + 1 < w
-            && y + 1 < h
-            && [i - 1, i + 1, i - w, i + w].iter().all(|&j| keys[j] == k);
-        let Some(e) = hist.get_mut(k as usize) else {
-            continue;
-        };
-        e.0 += 1;
-        e.1 += u64::from(interior);
-        for (sum, &v) in e.2.iter_mut().zip(c) {
-            *sum += v as f64;
-        }
-    }
-    // A colour that only lines the edges of others (the greys of
-    // anti-aliasing between black ink and white paper) is a mix, not an
-    // ink: a palette colour must fill patches of its own.
-    let min_interior = ((w * h) as u64 / 2000).max(1);
-    let mut bins: Vec<(u64, [f32; 3])> = hist
-        .iter()
-        .filter(|(n, interior, _)| *n > 0 && *interior >= min_interior)
-        .map(|(n, _, s)| (*n, [0, 1, 2].map(|k| (s[k] / *n as f64) as f32)))
-        .collect();
-    bins.sort_by(|a, b| {
-        b.0.cmp(&a.0)
-            .then(a.1.partial_cmp(&b.1).unwrap_or(std::cmp::Ordering::Equal))
-    });
-    let min_count = ((w * h) as u64 / 500).max(1);
-    let dist2 = |a: &[f32; 3], b: &[f32; 3]| (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f32>();
-    let mut palette: Vec<[f32; 3]> = Vec::new();
-    for (n, c) in &bins {
-        if *n < min_count || palette.len() >= 8 {
-            break;
-        }
-        if palette.iter().all(|p| dist2(p, c) > 48.0 * 48.0) {
-            palette.push(*c);
-        }
-    }
-    // Paper: the most common colour on the border (white if none).
-    let mut border = vec![0usize; 1 << 12];
-    for (i, c) in rgb.iter().enumerate() {
-        let (x, y) = (i % w, i / w);
-        if x == 0 || y == 0 || x + 1 == w || y + 1 == h {
-            if let Some(n) = border.get_mut(key(c) as usize) {
-                *n += 1;
-            }
-        }
-    }
-    let paper_key = border
-        .iter()
-        .enumerate()
-        .filter(|(_, &n)| n > 0)
-        .max_by_key(|(k, &n)| (n, std::cmp::Reverse(*k)))
-        .map(|(k, _)| k as u32);
-    let paper = palette
-        .iter()
-        .position(|p| Some(key(p)) == paper_key)
-        .or_else(|| {
-            palette
-                .iter()
-                .position(|p| dist2(p, &[255.0; 3]) < 48.0 * 48.0)
-        });
-    let paper_colour = paper.map(|i| palette[i]).unwrap_or([255.0; 3]);
-    if let Some(i) = paper {
-        palette.remove(i);
-    }
-    palette.insert(0, paper_colour);
-    if invert {
-        // Inverting swaps the roles: trace the paper as the only layer.
-        palette.truncate(1);
-    }
-    let k = palette.len();
-    // Per pixel, weights of its two nearest palette colours (pixels in
-    // parallel: each writes its own `k` weights).
-    // The pairs (a ≤ b) with their difference and its squared length,
-    // computed once.
-    let pairs: Vec<(usize, usize, [f32; 3], f32)> = (0..k)
-        .flat_map(|a| (a..k).map(move |b| (a, b)))
-        .map(|(a, b)| {
-            let (pa, pb) = (&palette[a], &palette[b]);
-            let d = [0, 1, 2].map(|j| pa[j] - pb[j]);
-            let dd: f32 = d.iter().map(|v| v * v).sum();
-            (a, b, d, dd)
-        })
-        .collect();
-    let nearest_mix = |c: &[f32; 3]| {
-        let mut best = (f32::MAX, 0usize, 0usize, 1.0f32);
-        for &(a, b, d, dd) in &pairs {
-            let pb = &palette[b];
-            let t = if dd > 0.0 {
-                (((0..3).map(|j| (c[j] - pb[j]) * d[j]).sum::<f32>()) / dd).clamp(0.0, 1.0)
-            } else {
-                1.0
-            };
-            let mix = [0, 1, 2].map(|j| pb[j] + t * d[j]);
-            let e = dist2(&mix, c);
-            if e < best.0 {
-                best = (e, a, b, t);
-            }
-        }
-        (best.1, best.2, best.3)
-    };
-    // A pixel with the value of the one before it in its row takes that
-    // one's mix (flat art is long runs of one value); rows in parallel.
-    let value = |p: &[u8; 4]| u32::from_le_bytes(*p);
-    let mut weights = vec![0f32; w * h * k];
-    weights
-        .par_chunks_mut((k * w).max(1))
-        .zip(px.par_chunks(w.max(1)).zip(rgb.par_chunks(w.max(1))))
-        .for_each(|(row, (prow, crow))| {
-            let mut last: Option<(u32, (usize, usize, f32))> = None;
-            for ((wt, p), c) in row.chunks_mut(k.max(1)).zip(prow).zip(crow) {
-                let v = value(p);
-                let (a, b, t) = match last {
-                    Some((lv, mix)) if lv == v => mix,
-                    _ => {
-                        let mix = nearest_mix(c);
-                        last = Some((v, mix));
-                        mix
-                    }
-                };
-                if let Some(x) = wt.get_mut(a) {
-                    *x += t;
-                }
-                if let Some(x) = wt.get_mut(b) {
-                    *x += 1.0 - t;
-                }
-            }
-        });
-    if invert {
-        let cov = Grid::from_fn(w, h, |x, y| weights[(y * w + x) * k]);
-        let c = palette[0];
-        return vec![(Color::rgb(c[0] as u8, c[1] as u8, c[2] as u8), cov)];
-    }
-    if union_only {
+    let palette = Palette::of(px, w, h, has_alpha, invert);
+    let k = palette.colours.len();
+    let w1 = w.max(1);
+    if union_only && !invert {
         // Only the bottom of the stack (every ink), black; nothing when the
-        // palette holds no ink.
+        // palette holds no ink. A pixel's ink is the share of its mix that
+        // is not paper (colour 0), added up as the layers' weights are.
         if k < 2 {
             return Vec::new();
         }
-        let all: Vec<f32> = weights
-            .par_chunks(k)
-            .map(|wt| wt.iter().skip(1).sum::<f32>().min(1.0))
-            .collect();
+        let mut all = vec![0f32; w * h];
+        all.par_chunks_mut(MIX_ROWS * w1)
+            .enumerate()
+            .for_each(|(band, out)| {
+                let first = band * MIX_ROWS;
+                palette.mixes(
+                    px,
+                    w,
+                    first..(first + MIX_ROWS).min(h),
+                    &mut |i, (a, b, t)| {
+                        out[i - first * w] = if a >= 1 {
+                            (t + (1.0 - t)).min(1.0)
+                        } else if b >= 1 {
+                            (1.0 - t).min(1.0)
+                        } else {
+                            0.0
+                        };
+                    },
+                )
+            });
         return Grid::from_vec(w, h, all)
             .map(|g| vec![(Color::BLACK, g)])
             .unwrap_or_default();
     }
+    // Per pixel, the weights of its two nearest palette colours (each
+    // band of rows writes its own pixels' `k` weights).
+    let mut weights = vec![0f32; w * h * k];
+    weights
+        .par_chunks_mut((MIX_ROWS * k * w).max(1))
+        .enumerate()
+        .for_each(|(band, out)| {
+            let first = band * MIX_ROWS;
+            palette.mixes(
+                px,
+                w,
+                first..(first + MIX_ROWS).min(h),
+                &mut |i, (a, b, t)| {
+                    let wt = &mut out[(i - first * w) * k..(i - first * w + 1) * k];
+                    if let Some(x) = wt.get_mut(a) {
+                        *x += t;
+                    }
+                    if let Some(x) = wt.get_mut(b) {
+                        *x += 1.0 - t;
+                    }
+                },
+            )
+        });
+    if invert {
+        let cov = Grid::from_fn(w, h, |x, y| weights[(y * w + x) * k]);
+        let c = palette.colours[0];
+        return vec![(Color::rgb(c[0] as u8, c[1] as u8, c[2] as u8), cov)];
+    }
+    if union_only {
+        return Vec::new();
+    }
     // Stack by area, largest at the bottom.
     let mut order: Vec<usize> = (1..k).collect();
-    let area = |j: usize| (0..w * h).map(|i| weights[i * k + j] as f64).sum::<f64>();
-    let areas: Vec<f64> = (0..k).map(area).collect();
+    let mut areas = vec![0f64; k];
+    for wt in weights.chunks_exact(k.max(1)) {
+        for (a, &v) in areas.iter_mut().zip(wt) {
+            *a += v as f64;
+        }
+    }
     order.sort_by(|&a, &b| areas[b].total_cmp(&areas[a]).then(a.cmp(&b)));
     order
         .iter()
@@ -681,19 +917,16 @@ fn quantized_layers(
         .filter(|(_, &j)| areas[j] > 0.0)
         .map(|(pos, &j)| {
             let above = &order[pos..];
-            let cov = Grid::from_fn(w, h, |x, y| {
-                let i = y * w + x;
-                above
-                    .iter()
-                    .map(|&m| weights[i * k + m])
-                    .sum::<f32>()
-                    .min(1.0)
-            });
-            let c = palette[j];
-            (
-                Color::rgb(c[0].round() as u8, c[1].round() as u8, c[2].round() as u8),
-                cov,
+            let cov = Grid::from_vec(
+                w,
+                h,
+                weights
+                    .par_chunks(k.max(1))
+                    .map(|wt| above.iter().map(|&m| wt[m]).sum::<f32>().min(1.0))
+                    .collect(),
             )
+            .unwrap_or_else(|| Grid::new(w, h, 0.0));
+            (palette.colour(j), cov)
         })
         .collect()
 }
@@ -732,6 +965,309 @@ mod tests {
             Color::rgb(g, g, g)
         });
         (crate::raster::is_binary(&cov), color, cov)
+    }
+
+    /// The palette quantization as first written (every pixel's colour
+    /// and key held, the mix worked out for every pixel not equal to the
+    /// one before it, the weights of every layer held): the oracle of the
+    /// cached, banded version.
+    #[allow(clippy::type_complexity)]
+    fn quantized_reference(
+        px: &[[u8; 4]],
+        w: usize,
+        h: usize,
+        has_alpha: bool,
+        invert: bool,
+        union_only: bool,
+    ) -> Vec<(Color, Coverage)> {
+        // Composite over white so transparency reads as paper.
+        let rgb: Vec<[f32; 3]> = px
+            .iter()
+            .map(|p| {
+                let a = if has_alpha { p[3] as f32 / 255.0 } else { 1.0 };
+                [0, 1, 2].map(|k| p[k] as f32 * a + 255.0 * (1.0 - a))
+            })
+            .collect();
+        let key = |c: &[f32; 3]| {
+            ((c[0] as u32 >> 4) << 8) | ((c[1] as u32 >> 4) << 4) | (c[2] as u32 >> 4)
+        };
+        let keys: Vec<u32> = rgb.iter().map(key).collect();
+        // Per colour bin: pixels, pixels inside a patch of the colour (their
+        // four neighbours in the same bin), and the sum of the colours.
+        // (Keys are 12 bits: one slot per key, visited in key order.)
+        let mut hist = vec![(0u64, 0u64, [0f64; 3]); 1 << 12];
+        for (i, c) in rgb.iter().enumerate() {
+            let (x, y) = (i % w, i / w);
+            let k = keys[i];
+            let interior = x > 0
+                && y > 0
+                && x + 1 < w
+                && y + 1 < h
+                && [i - 1, i + 1, i - w, i + w].iter().all(|&j| keys[j] == k);
+            let Some(e) = hist.get_mut(k as usize) else {
+                continue;
+            };
+            e.0 += 1;
+            e.1 += u64::from(interior);
+            for (sum, &v) in e.2.iter_mut().zip(c) {
+                *sum += v as f64;
+            }
+        }
+        // A colour that only lines the edges of others (the greys of
+        // anti-aliasing between black ink and white paper) is a mix, not an
+        // ink: a palette colour must fill patches of its own.
+        let min_interior = ((w * h) as u64 / 2000).max(1);
+        let mut bins: Vec<(u64, [f32; 3])> = hist
+            .iter()
+            .filter(|(n, interior, _)| *n > 0 && *interior >= min_interior)
+            .map(|(n, _, s)| (*n, [0, 1, 2].map(|k| (s[k] / *n as f64) as f32)))
+            .collect();
+        bins.sort_by(|a, b| {
+            b.0.cmp(&a.0)
+                .then(a.1.partial_cmp(&b.1).unwrap_or(std::cmp::Ordering::Equal))
+        });
+        let min_count = ((w * h) as u64 / 500).max(1);
+        let dist2 = |a: &[f32; 3], b: &[f32; 3]| (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f32>();
+        let mut palette: Vec<[f32; 3]> = Vec::new();
+        for (n, c) in &bins {
+            if *n < min_count || palette.len() >= 8 {
+                break;
+            }
+            if palette.iter().all(|p| dist2(p, c) > 48.0 * 48.0) {
+                palette.push(*c);
+            }
+        }
+        // Paper: the most common colour on the border (white if none).
+        let mut border = vec![0usize; 1 << 12];
+        for (i, c) in rgb.iter().enumerate() {
+            let (x, y) = (i % w, i / w);
+            if x == 0 || y == 0 || x + 1 == w || y + 1 == h {
+                if let Some(n) = border.get_mut(key(c) as usize) {
+                    *n += 1;
+                }
+            }
+        }
+        let paper_key = border
+            .iter()
+            .enumerate()
+            .filter(|(_, &n)| n > 0)
+            .max_by_key(|(k, &n)| (n, std::cmp::Reverse(*k)))
+            .map(|(k, _)| k as u32);
+        let paper = palette
+            .iter()
+            .position(|p| Some(key(p)) == paper_key)
+            .or_else(|| {
+                palette
+                    .iter()
+                    .position(|p| dist2(p, &[255.0; 3]) < 48.0 * 48.0)
+            });
+        let paper_colour = paper.map(|i| palette[i]).unwrap_or([255.0; 3]);
+        if let Some(i) = paper {
+            palette.remove(i);
+        }
+        palette.insert(0, paper_colour);
+        if invert {
+            // Inverting swaps the roles: trace the paper as the only layer.
+            palette.truncate(1);
+        }
+        let k = palette.len();
+        // Per pixel, weights of its two nearest palette colours (pixels in
+        // parallel: each writes its own `k` weights).
+        // The pairs (a ≤ b) with their difference and its squared length,
+        // computed once.
+        let pairs: Vec<(usize, usize, [f32; 3], f32)> = (0..k)
+            .flat_map(|a| (a..k).map(move |b| (a, b)))
+            .map(|(a, b)| {
+                let (pa, pb) = (&palette[a], &palette[b]);
+                let d = [0, 1, 2].map(|j| pa[j] - pb[j]);
+                let dd: f32 = d.iter().map(|v| v * v).sum();
+                (a, b, d, dd)
+            })
+            .collect();
+        let nearest_mix = |c: &[f32; 3]| {
+            let mut best = (f32::MAX, 0usize, 0usize, 1.0f32);
+            for &(a, b, d, dd) in &pairs {
+                let pb = &palette[b];
+                let t = if dd > 0.0 {
+                    (((0..3).map(|j| (c[j] - pb[j]) * d[j]).sum::<f32>()) / dd).clamp(0.0, 1.0)
+                } else {
+                    1.0
+                };
+                let mix = [0, 1, 2].map(|j| pb[j] + t * d[j]);
+                let e = dist2(&mix, c);
+                if e < best.0 {
+                    best = (e, a, b, t);
+                }
+            }
+            (best.1, best.2, best.3)
+        };
+        // A pixel with the value of the one before it in its row takes that
+        // one's mix (flat art is long runs of one value); rows in parallel.
+        let value = |p: &[u8; 4]| u32::from_le_bytes(*p);
+        let mut weights = vec![0f32; w * h * k];
+        weights
+            .par_chunks_mut((k * w).max(1))
+            .zip(px.par_chunks(w.max(1)).zip(rgb.par_chunks(w.max(1))))
+            .for_each(|(row, (prow, crow))| {
+                let mut last: Option<(u32, (usize, usize, f32))> = None;
+                for ((wt, p), c) in row.chunks_mut(k.max(1)).zip(prow).zip(crow) {
+                    let v = value(p);
+                    let (a, b, t) = match last {
+                        Some((lv, mix)) if lv == v => mix,
+                        _ => {
+                            let mix = nearest_mix(c);
+                            last = Some((v, mix));
+                            mix
+                        }
+                    };
+                    if let Some(x) = wt.get_mut(a) {
+                        *x += t;
+                    }
+                    if let Some(x) = wt.get_mut(b) {
+                        *x += 1.0 - t;
+                    }
+                }
+            });
+        if invert {
+            let cov = Grid::from_fn(w, h, |x, y| weights[(y * w + x) * k]);
+            let c = palette[0];
+            return vec![(Color::rgb(c[0] as u8, c[1] as u8, c[2] as u8), cov)];
+        }
+        if union_only {
+            // Only the bottom of the stack (every ink), black; nothing when the
+            // palette holds no ink.
+            if k < 2 {
+                return Vec::new();
+            }
+            let all: Vec<f32> = weights
+                .par_chunks(k)
+                .map(|wt| wt.iter().skip(1).sum::<f32>().min(1.0))
+                .collect();
+            return Grid::from_vec(w, h, all)
+                .map(|g| vec![(Color::BLACK, g)])
+                .unwrap_or_default();
+        }
+        // Stack by area, largest at the bottom.
+        let mut order: Vec<usize> = (1..k).collect();
+        let area = |j: usize| (0..w * h).map(|i| weights[i * k + j] as f64).sum::<f64>();
+        let areas: Vec<f64> = (0..k).map(area).collect();
+        order.sort_by(|&a, &b| areas[b].total_cmp(&areas[a]).then(a.cmp(&b)));
+        order
+            .iter()
+            .enumerate()
+            .filter(|(_, &j)| areas[j] > 0.0)
+            .map(|(pos, &j)| {
+                let above = &order[pos..];
+                let cov = Grid::from_fn(w, h, |x, y| {
+                    let i = y * w + x;
+                    above
+                        .iter()
+                        .map(|&m| weights[i * k + m])
+                        .sum::<f32>()
+                        .min(1.0)
+                });
+                let c = palette[j];
+                (
+                    Color::rgb(c[0].round() as u8, c[1].round() as u8, c[2].round() as u8),
+                    cov,
+                )
+            })
+            .collect()
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(48))]
+
+        /// The banded, cached quantization gives the reference's layers,
+        /// colours and coverages bit for bit: flat art with anti-aliased
+        /// mixes, noise (every pixel its own value), transparency, the
+        /// union of all inks and the paper alone.
+        #[test]
+        fn quantized_layers_match_the_reference(
+            w in 1usize..70,
+            h in 1usize..90,
+            inks in 1usize..4,
+            noise in 0u8..12,
+            alpha in any::<bool>(),
+            invert in any::<bool>(),
+            union_only in any::<bool>(),
+            seed in any::<u64>(),
+        ) {
+            let colours = [[250u8, 245, 230], [20, 20, 30], [200, 60, 40], [40, 90, 200]];
+            let mut state = seed | 1;
+            let mut rnd = move || {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                state
+            };
+            let px: Vec<[u8; 4]> = (0..w * h)
+                .map(|i| {
+                    let (x, y) = ((i % w) as f64, (i / w) as f64);
+                    // Discs of each ink on the paper, blended at their rims.
+                    let mut c = colours[0].map(f64::from);
+                    for (k, ink) in colours.iter().enumerate().take(inks + 1).skip(1) {
+                        let (cx, cy) = (w as f64 * k as f64 / (inks + 1) as f64, h as f64 / 2.0);
+                        let cov = (0.5 - ((x - cx).hypot(y - cy) - 0.3 * w.min(h) as f64)).clamp(0.0, 1.0);
+                        for (v, &i) in c.iter_mut().zip(ink) {
+                            *v += cov * (f64::from(i) - *v);
+                        }
+                    }
+                    let mut out = [255u8; 4];
+                    for j in 0..3 {
+                        let r = (rnd() % (2 * u64::from(noise) + 1)) as f64 - f64::from(noise);
+                        out[j] = (c[j] + r).round().clamp(0.0, 255.0) as u8;
+                    }
+                    if alpha {
+                        out[3] = (rnd() % 256) as u8;
+                    }
+                    out
+                })
+                .collect();
+            let union_only = union_only && !invert;
+            let got = quantized_layers(&px, w, h, alpha, invert, union_only);
+            let want = quantized_reference(&px, w, h, alpha, invert, union_only);
+            prop_assert_eq!(got.len(), want.len());
+            for ((gc, gcov), (wc, wcov)) in got.iter().zip(&want) {
+                prop_assert_eq!(gc, wc);
+                prop_assert_eq!(gcov.data(), wcov.data());
+            }
+        }
+    }
+
+    /// A grey picture stored as colour (three equal channels) traces as
+    /// the same picture stored as grey, byte for byte.
+    #[test]
+    fn grey_stored_as_colour_reads_as_grey() {
+        let (w, h) = (90u32, 70u32);
+        let grey = image::GrayImage::from_fn(w, h, |x, y| {
+            let d = (f64::from(x) - 40.0).hypot(f64::from(y) - 30.0) - 20.0;
+            image::Luma([(255.0 * (0.5 + d).clamp(0.0, 1.0)).round() as u8])
+        });
+        let rgb = image::RgbImage::from_fn(w, h, |x, y| {
+            let g = grey.get_pixel(x, y)[0];
+            image::Rgb([g, g, g])
+        });
+        let bytes = |img: image::DynamicImage| {
+            let mut out = std::io::Cursor::new(Vec::new());
+            img.write_to(&mut out, image::ImageFormat::Png)
+                .expect("encodes");
+            out.into_inner()
+        };
+        let opts = ImageOptions::default();
+        let (a, _) = raster_coverage(&bytes(grey.into()), &opts).expect("reads");
+        let (b, _) = raster_coverage(&bytes(rgb.into()), &opts).expect("reads");
+        match (a, b) {
+            (
+                RasterCoverage::Layers { layers: la, .. },
+                RasterCoverage::Layers { layers: lb, .. },
+            ) => {
+                assert_eq!(la.len(), 1);
+                assert_eq!(la[0].0, lb[0].0);
+                assert_eq!(la[0].1.data(), lb[0].1.data());
+            }
+            _ => panic!("an anti-aliased disc reads as one layer of coverage"),
+        }
     }
 
     proptest! {

@@ -81,13 +81,88 @@ pub fn looks_like_svg(bytes: &[u8]) -> bool {
 
 /// What `flourish trace` reads from a file: for SVG input, layers of ink
 /// with an SDF each; for a raster, the outline of each layer's ink, fitted
-/// directly (no SDF is built).
+/// directly (no SDF is built); or, cut out, the regions of a picture's
+/// colours.
 #[derive(Clone, Debug)]
 pub enum Traceable {
     /// Layers with signed distance fields.
     Field(Ink),
     /// A raster's outlines, one layer per ink colour.
     Outline(OutlineInk),
+    /// A picture as regions of its colours, the paper's too.
+    Regions(RegionInk),
+}
+
+/// A picture read as regions of its colours ([`crate::raster::regions`]).
+#[derive(Clone, Debug)]
+pub struct RegionInk {
+    /// Width in the input's units (pixels for a raster).
+    pub width: f64,
+    /// Height in the input's units.
+    pub height: f64,
+    /// The regions, in pixels.
+    pub partition: crate::raster::regions::Partition,
+    /// Each label's colour, the paper's first.
+    pub colours: Vec<Color>,
+    /// Maps pixel coordinates to the input's units.
+    pub to_user: Affine,
+    /// How the picture was read, one line each (for `--verbose`).
+    pub notes: Vec<String>,
+}
+
+/// Reads raster or SVG bytes as the regions of their colours, for
+/// `--layers --cutout`: a raster at its own size, an SVG rendered (as
+/// browsers show it) at `opts.resolution` on its longest side.
+pub fn read_regions(bytes: &[u8], opts: &ImageOptions) -> Result<RegionInk> {
+    opts.validate()?;
+    if opts.invert {
+        return Err(Error::Option {
+            name: "invert",
+            reason: "a cut-out traces every colour, the paper's too".into(),
+        });
+    }
+    if looks_like_svg(bytes) {
+        let bytes = crate::read::svg::inflate_svgz(bytes)?;
+        let tree = crate::read::svg::parse_svg(&bytes)?;
+        let size = tree.size();
+        let (uw, uh) = (size.width() as f64, size.height() as f64);
+        let scale = opts.resolution as f64 / uw.max(uh);
+        let (pw, ph) = ((uw * scale).ceil() as u64, (uh * scale).ceil() as u64);
+        io::check_canvas(pw.max(1), ph.max(1))?;
+        let (pw, ph) = (pw.max(1) as usize, ph.max(1) as usize);
+        let mut pixmap = tiny_skia::Pixmap::new(pw as u32, ph as u32)
+            .ok_or_else(|| Error::invalid("cannot allocate the render canvas"))?;
+        // On white paper, as the drawing shows.
+        pixmap.fill(tiny_skia::Color::WHITE);
+        let canvas = tiny_skia::Transform::from_scale(scale as f32, scale as f32);
+        resvg::render(&tree, canvas, &mut pixmap.as_mut());
+        let px: Vec<[u8; 4]> = pixmap
+            .pixels()
+            .iter()
+            .map(|p| {
+                let c = p.demultiply();
+                [c.red(), c.green(), c.blue(), c.alpha()]
+            })
+            .collect();
+        let (partition, colours) = super::image::pixel_partition(&px, pw, ph)?;
+        return Ok(RegionInk {
+            width: uw,
+            height: uh,
+            partition,
+            colours,
+            to_user: Affine::scale(1.0 / scale),
+            notes: Vec::new(),
+        });
+    }
+    let (partition, colours, lighting) = super::image::raster_partition(bytes)?;
+    Ok(RegionInk {
+        width: partition.width() as f64,
+        height: partition.height() as f64,
+        partition,
+        colours,
+        to_user: Affine::IDENTITY,
+        notes: lighting.iter().map(|l| l.note()).collect(),
+    })
 }
 
 /// A raster read as the outlines of its ink layers: a binary layer's smooth

@@ -141,6 +141,7 @@ impl Lighting {
     }
 
     /// The paper's brightness (0..=1) at the centre of pixel (x, y).
+    #[cfg(test)]
     pub fn paper_at(&self, x: usize, y: usize) -> f64 {
         let u = 2.0 * (x as f64 + 0.5) / self.width as f64 - 1.0;
         let v = 2.0 * (y as f64 + 0.5) / self.height as f64 - 1.0;
@@ -158,6 +159,7 @@ impl Lighting {
 
     /// The factor pixel (x, y)'s values are multiplied by to light it as
     /// the brightest paper is lit.
+    #[cfg(test)]
     fn gain(&self, x: usize, y: usize) -> f32 {
         // The fitted surface stays positive over the paper it was fitted
         // to; between blocks filled with ink it may not, where it is held
@@ -166,12 +168,31 @@ impl Lighting {
         (self.brightest / paper) as f32
     }
 
+    /// The gains of row `y` (see [`Lighting::gain`]), pixel by pixel: the
+    /// surface along a row is a cubic in `u` whose coefficients are read
+    /// off the two-variable one once per row and evaluated by Horner's
+    /// rule (the same polynomial, to rounding).
+    fn row_gains(&self, y: usize) -> impl Iterator<Item = f32> + '_ {
+        let v = 2.0 * (y as f64 + 0.5) / self.height as f64 - 1.0;
+        let c = &self.coef;
+        let a0 = c[0] + v * (c[2] + v * (c[5] + v * c[9]));
+        let a1 = c[1] + v * (c[4] + v * c[8]);
+        let a2 = c[3] + v * c[7];
+        let a3 = c[6];
+        let w = self.width as f64;
+        (0..self.width).map(move |x| {
+            let u = 2.0 * (x as f64 + 0.5) / w - 1.0;
+            let paper = (a0 + u * (a1 + u * (a2 + u * a3))).max(self.darkest);
+            (self.brightest / paper) as f32
+        })
+    }
+
     /// Evens out the light of grey pixels (0..=255, row by row) in place.
     pub fn flatten_grey(&self, grey: &mut [u8]) {
         let w = self.width.max(1);
         grey.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-            for (x, v) in row.iter_mut().enumerate() {
-                *v = scaled(*v, self.gain(x, y));
+            for (v, g) in row.iter_mut().zip(self.row_gains(y)) {
+                *v = scaled(*v, g);
             }
         });
     }
@@ -181,8 +202,7 @@ impl Lighting {
     pub fn flatten_rgba(&self, px: &mut [[u8; 4]]) {
         let w = self.width.max(1);
         px.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-            for (x, p) in row.iter_mut().enumerate() {
-                let g = self.gain(x, y);
+            for (p, g) in row.iter_mut().zip(self.row_gains(y)) {
                 for c in &mut p[..3] {
                     *c = scaled(*c, g);
                 }
@@ -193,7 +213,7 @@ impl Lighting {
 
 /// `v` times `gain`, rounded and held to 0..=255.
 fn scaled(v: u8, gain: f32) -> u8 {
-    (f32::from(v) * gain).round().clamp(0.0, 255.0) as u8
+    crate::raster::round_positive((f32::from(v) * gain).clamp(0.0, 255.0)) as u8
 }
 
 /// The surface `coef` at terms `t`.
@@ -344,6 +364,23 @@ mod tests {
             assert!((f64::from(p[1]) - r / 2.0).abs() <= 1.0, "{p:?}");
             assert!((f64::from(p[2]) - r / 4.0).abs() <= 1.0, "{p:?}");
             assert_eq!(p[3], 255);
+        }
+    }
+
+    /// The gains a row is evened out by are the surface's, pixel by pixel
+    /// (to float rounding).
+    #[test]
+    fn row_gains_are_the_surface() {
+        let (w, h) = (173, 97);
+        let light = |u: f64, v: f64| 0.95 - 0.5 * (0.7 * u * u * u + 0.3 * v - 0.2 * u * v * v);
+        let img = photo(w, h, light);
+        let l = Lighting::measure(w, h, at(&img, w)).expect("uneven");
+        for y in 0..h {
+            for (x, g) in l.row_gains(y).enumerate() {
+                let want = l.gain(x, y);
+                assert!((g - want).abs() <= 1e-6 * want, "({x}, {y}): {g} vs {want}");
+            }
+            assert_eq!(l.row_gains(y).count(), w);
         }
     }
 

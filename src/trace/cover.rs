@@ -70,9 +70,24 @@ pub fn fit_outline(
     corridor: Option<&Corridor>,
     out: &mut BezPath,
 ) {
+    append_loop(
+        &outline_cubics(pts, tangents, corners, accuracy, corridor),
+        out,
+    );
+}
+
+/// The cubics [`fit_outline`] closes into a loop, in order round it
+/// (none for fewer than three points).
+pub fn outline_cubics(
+    pts: &[Point],
+    tangents: &[Vec2],
+    corners: &[usize],
+    accuracy: f64,
+    corridor: Option<&Corridor>,
+) -> Vec<CubicBez> {
     let n = pts.len();
     if n < 3 || tangents.len() != n {
-        return;
+        return Vec::new();
     }
     let mut cs: Vec<usize> = corners.iter().copied().filter(|&c| c < n).collect();
     cs.dedup();
@@ -106,7 +121,58 @@ pub fn fit_outline(
             .collect();
         covered.into_iter().flatten().collect()
     };
-    append_loop(&cubics, out);
+    cubics
+}
+
+/// Fits an open polyline (pixel coordinates) from its first point to its
+/// last with cubic Béziers within `accuracy` px of it: `tangents` at its
+/// points, `corners` (ascending, both ends among them) where cubics meet
+/// at an angle. Each run between corners is covered as a closed
+/// outline's is; the ends stay where they are.
+pub fn fit_open(
+    pts: &[Point],
+    tangents: &[Vec2],
+    corners: &[usize],
+    accuracy: f64,
+) -> Vec<CubicBez> {
+    let n = pts.len();
+    if n < 2 || tangents.len() != n {
+        return Vec::new();
+    }
+    let mut cs: Vec<usize> = corners.iter().copied().filter(|&c| c < n).collect();
+    cs.sort_unstable();
+    cs.dedup();
+    if cs.first() != Some(&0) {
+        cs.insert(0, 0);
+    }
+    if cs.last() != Some(&(n - 1)) {
+        cs.push(n - 1);
+    }
+    let mut cubics = Vec::new();
+    for w in cs.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        let piece = Piece::new(
+            pts[a..=b].to_vec(),
+            tangents[a..=b].to_vec(),
+            Guide::Outline(None),
+            true,
+            true,
+        );
+        let before = cubics.len();
+        cover_run(&piece, accuracy, &mut cubics);
+        if cubics.len() == before && pts[a] != pts[b] {
+            cubics.push(line_cubic(pts[a], pts[b]));
+        }
+        // The run's ends exactly where its corners are.
+        if let Some(c) = cubics.get_mut(before) {
+            c.p0 = pts[a];
+        }
+        let len = cubics.len();
+        if len > before {
+            cubics[len - 1].p3 = pts[b];
+        }
+    }
+    cubics
 }
 
 /// Accumulated turning (radians) of the piece at each vertex, measured

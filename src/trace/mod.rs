@@ -25,6 +25,7 @@
 //! flourish measures it against potrace (`make bench`).
 
 pub mod cover;
+pub mod cutout;
 mod direct;
 pub mod fit;
 mod nearest;
@@ -370,6 +371,26 @@ pub fn trace(picture: &Traceable, opts: &TraceOptions) -> Result<Output> {
     opts.validate()?;
     match picture {
         Traceable::Field(ink) => trace_ink(ink, opts),
+        Traceable::Regions(r) => {
+            let px_per_unit = 1.0 / r.to_user.determinant().abs().sqrt().max(1e-12);
+            let mut doc = Document::new(
+                r.width,
+                r.height,
+                decimals_for(opts.tolerance / px_per_unit),
+            );
+            doc.groups =
+                cutout::trace_partition(&r.partition, &r.colours, opts.tolerance, opts.min_area);
+            for g in &mut doc.groups {
+                for s in &mut g.shapes {
+                    s.path = r.to_user * s.path.clone();
+                }
+            }
+            Ok(Output {
+                document: doc,
+                warnings: Vec::new(),
+                notes: r.notes.clone(),
+            })
+        }
         Traceable::Outline(o) => {
             let mut doc = Document::new(o.width, o.height, decimals_for(opts.tolerance));
             for (i, layer) in o.layers.iter().enumerate() {

@@ -527,6 +527,11 @@ impl Piece<'_> {
     ) -> Option<[(Point, Vec2); FIT_SAMPLES]> {
         let step = (range.end - range.start) / (FIT_SAMPLES - 1) as f64;
         let mut out = [(Point::ORIGIN, Vec2::ZERO); FIT_SAMPLES];
+        if let (Guide::Outline(_), true) = (self.guide, step >= 0.0) {
+            if self.tangents.len() == self.pts.len() && self.pts.len() >= 2 {
+                return self.outline_samples_while(range.start, step, ok, out);
+            }
+        }
         let mut prev: Option<Vec2> = None;
         // The samples ascend: each segment is found by stepping on from
         // the last one.
@@ -544,6 +549,65 @@ impl Piece<'_> {
             }
             prev = Some(s.tangent);
             *o = (s.p + self.origin, s.tangent);
+        }
+        Some(out)
+    }
+
+    /// [`Self::samples_while`] on an outline with its tangents given, for
+    /// ascending samples from `start` by `step` (shares of the length):
+    /// the same samples, [`Self::sample_at`]'s outline branch written out
+    /// on one cursor over the segments, so a sample costs a step along
+    /// the outline and an interpolated tangent.
+    fn outline_samples_while(
+        &self,
+        start: f64,
+        step: f64,
+        ok: impl Fn(Vec2, Vec2) -> bool,
+        mut out: [(Point, Vec2); FIT_SAMPLES],
+    ) -> Option<[(Point, Vec2); FIT_SAMPLES]> {
+        let (pts, cum, tangents) = (&self.pts, &self.cum, &self.tangents);
+        let n = pts.len();
+        let len = self.length();
+        let o = self.origin;
+        let mut i = self.locate(start * len).0;
+        let mut prev: Option<Vec2> = None;
+        for (k, slot) in out.iter_mut().enumerate() {
+            let t = start + k as f64 * step;
+            let s = (t * len).clamp(0.0, len);
+            while i + 2 < n && cum[i + 1] <= s {
+                i += 1;
+            }
+            let seg = cum[i + 1] - cum[i];
+            let f = if seg > 0.0 { (s - cum[i]) / seg } else { 0.0 };
+            let p = pts[i].lerp(pts[i + 1], f);
+            let at_start = t <= 0.0;
+            let at_end = t >= 1.0;
+            let tangent = if (at_start && self.corner_start) || (at_end && self.corner_end) {
+                self.chord_dir(t * len, at_start || !at_end)
+            } else {
+                let g = if seg > 0.0 {
+                    ((t * len - cum[i]) / seg).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                let v = tangents[i].lerp(tangents[i + 1], g);
+                let l = v.hypot();
+                let s = t * len;
+                if l > 1e-9 {
+                    v / l
+                } else if self.corner_start && s < CORNER_REACH
+                    || self.corner_end && len - s < CORNER_REACH
+                {
+                    self.chord_dir(s, self.corner_start && s < CORNER_REACH)
+                } else {
+                    self.seg_dir(i)
+                }
+            };
+            if prev.is_some_and(|q| !ok(q, tangent)) {
+                return None;
+            }
+            prev = Some(tangent);
+            *slot = ((p - o) + o, tangent);
         }
         Some(out)
     }
