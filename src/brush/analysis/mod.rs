@@ -20,6 +20,7 @@
 pub mod cache;
 pub mod check;
 pub mod exemplar;
+pub mod facts;
 pub mod neighbourhood;
 pub mod spine;
 pub mod style;
@@ -32,6 +33,7 @@ use self::exemplar::LEVELS;
 use self::neighbourhood::{Neighbourhood, NeighbourhoodIndex, NeighbourhoodSampler, Pca, PCA_DIMS};
 use self::spine::SpineOptions;
 use crate::error::{Error, Result};
+use crate::raster::Grid;
 use crate::read::style::{StyleKind, StyleToml, STYLE_FILE};
 
 use kurbo::Point;
@@ -166,12 +168,14 @@ pub fn analyse(
         let points: Vec<[f32; PCA_DIMS]> = all.par_iter().map(|v| pca.project(v)).collect();
         indexes.push(NeighbourhoodIndex::new(pca, points, refs));
     }
+    let exemplars: Vec<Exemplar> = analysed.into_iter().map(|(e, _)| e).collect();
     Ok(BrushStyle {
         name: name.to_string(),
         resolution,
         sdf,
         sampler,
-        exemplars: analysed.into_iter().map(|(e, _)| e).collect(),
+        facts: facts::StyleFacts::of(&exemplars),
+        exemplars,
         indexes,
     })
 }
@@ -281,11 +285,14 @@ fn analyse_exemplar(
             }
         }
         hoods.push(v);
-        levels.push(ExemplarLevel {
+        let mut level = ExemplarLevel {
             scale,
             ink: lv,
             orientation: field,
-        });
+            top: Grid::new(0, 0, 0),
+        };
+        level.index_layers();
+        levels.push(level);
     }
     let arr = |p: &Point| [p.x, p.y];
     Ok((
