@@ -54,6 +54,7 @@ mod svg_out;
 mod trace;
 
 pub use brush::analysis::check::StyleReport;
+pub use brush::analysis::init::InitReport;
 pub use brush::{BrushOptions, Refinement, MAX_ITERATIONS};
 pub use diff::DiffReport;
 pub use error::{Error, Result};
@@ -198,6 +199,14 @@ impl Image {
 /// ```
 pub fn trace(image: &Image, opts: &TraceOptions) -> Result<Output> {
     trace::trace(&image.picture, opts)
+}
+
+/// Reads a folder of exemplar drawings (SVG or raster) for `flourish
+/// style init`: each one's main branch ends found (the farthest pair
+/// along the edge-tangent-flow geodesic), at `resolution` px (default
+/// 256). [`InitReport::to_toml`] is the library's `style.toml`.
+pub fn init_style(dir: &Path, resolution: Option<u32>) -> Result<InitReport> {
+    brush::analysis::init::init(dir, resolution)
 }
 
 /// Analyses a brush style for `flourish style check`: a report per

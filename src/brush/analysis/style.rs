@@ -22,6 +22,24 @@ pub enum SpineSource {
     Drawn,
     /// Traced between `start` and `end` (Dijkstra + quartic).
     Traced,
+    /// Traced between ends found at the two ends of the main branch
+    /// ([`super::ends`]), `style.toml` giving none.
+    Found,
+    /// Traced across the exemplar's longer side: `style.toml` gives no
+    /// ends and the drawing has no clear main branch (a dot, a ring).
+    Fallback,
+}
+
+impl SpineSource {
+    /// One word for reports.
+    pub fn word(self) -> &'static str {
+        match self {
+            SpineSource::Drawn => "drawn",
+            SpineSource::Traced => "traced",
+            SpineSource::Found => "found",
+            SpineSource::Fallback => "fallback",
+        }
+    }
 }
 
 /// One exemplar at one pyramid level.
@@ -92,6 +110,9 @@ pub struct Exemplar {
     pub extension: [f64; 2],
     /// The raw Dijkstra path (finest px) when the spine was traced.
     pub path: Vec<[f64; 2]>,
+    /// The spine's start and end in the exemplar's user units: as given,
+    /// drawn, or found ([`SpineSource`]).
+    pub ends: [[f64; 2]; 2],
     /// Rib samples (30–100), finest px.
     pub ribs: Ribs,
     /// Per-sample features, parallel to the ribs.
