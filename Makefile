@@ -6,13 +6,16 @@ OUT := out
 .PHONY: demo test gallery golden bench lint deps clean
 
 # Everything the tests need that cargo does not install: potrace, the
-# reference tracer the trace tests compare against.
+# reference tracer the trace tests compare against (Debian package).
 deps:
-	@command -v potrace >/dev/null 2>&1 || { \
+	@if command -v potrace >/dev/null 2>&1; then \
+	  echo "potrace: $$(command -v potrace)"; \
+	else \
 	  echo "installing potrace (Debian package) for the comparison tests"; \
-	  (apt-get update -qq && apt-get install -y -qq potrace) >/dev/null 2>&1 || \
-	  (sudo apt-get update -qq && sudo apt-get install -y -qq potrace) >/dev/null 2>&1 || \
-	  echo "could not install potrace: the potrace comparison will be skipped (it fails under CI)"; }
+	  (apt-get update -qq && apt-get install -y -qq potrace) || \
+	  (sudo apt-get update -qq && sudo apt-get install -y -qq potrace) || \
+	  { echo "make: potrace could not be installed: install the Debian package potrace" >&2; exit 1; }; \
+	fi
 
 # The main job on the shipped samples: traces and patterns, with previews, into out/.
 demo:
@@ -41,10 +44,12 @@ demo:
 	done
 	@echo "demo outputs (SVG + preview PNG) are in $(OUT)/"
 
-# The whole test suite (heavy tests run optimized: see [profile.test]).
+# The whole test suite, built once with the test profile (optimized: see
+# [profile.test]); the examples' binaries are built too, for
+# tests/examples.rs.
 test: deps
-	$(CARGO) build --workspace --all-targets
-	$(CARGO) test --tests
+	$(CARGO) build --profile test --workspace --all-targets
+	$(CARGO) test --workspace --tests
 
 # Every mode on the third-party art of ../shared/art (and the shipped
 # styles), measured against each issue's thresholds, with contact sheets

@@ -38,6 +38,14 @@ impl DiffReport {
 /// Renders both SVG texts at the same pixel size (the first one's, scaled to
 /// [`DIFF_SIDE`]) over white and compares them pixel by pixel.
 pub fn diff_svg_texts(a_name: &Path, a: &[u8], b_name: &Path, b: &[u8]) -> Result<DiffReport> {
+    for (name, bytes) in [(a_name, a), (b_name, b)] {
+        if !crate::read::ink::looks_like_svg(bytes) {
+            return Err(Error::invalid(
+                "not an SVG document (diff compares two SVG files; trace a picture first)",
+            )
+            .in_file(name));
+        }
+    }
     let ta = crate::read::svg::parse_svg(a).map_err(|e| e.in_file(a_name))?;
     let tb = crate::read::svg::parse_svg(b).map_err(|e| e.in_file(b_name))?;
     let (sa, sb) = (ta.size(), tb.size());

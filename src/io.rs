@@ -52,6 +52,28 @@ pub fn read_file(path: &Path) -> Result<Vec<u8>> {
     read_capped(path, MAX_FILE_BYTES)
 }
 
+/// Reads an input of the command line: `-` is standard input, read to its
+/// end (refused past [`MAX_FILE_BYTES`]); anything else [`read_file`].
+pub fn read_input(path: &Path) -> Result<Vec<u8>> {
+    use std::io::Read as _;
+    if path.as_os_str() != "-" {
+        return read_file(path);
+    }
+    let mut out = Vec::new();
+    std::io::stdin()
+        .lock()
+        .take(MAX_FILE_BYTES + 1)
+        .read_to_end(&mut out)
+        .map_err(|e| Error::io("<stdin>", e))?;
+    if out.len() as u64 > MAX_FILE_BYTES {
+        return Err(
+            Error::invalid(format!("more than the limit of {MAX_FILE_BYTES} bytes"))
+                .in_file("<stdin>"),
+        );
+    }
+    Ok(out)
+}
+
 /// Reads `path` to its end or to `cap` + 1 bytes, whichever comes first;
 /// more than `cap` bytes is an error.
 fn read_capped(path: &Path, cap: u64) -> Result<Vec<u8>> {
@@ -108,9 +130,10 @@ pub fn write_all_atomic(files: &[(&Path, &[u8])]) -> Result<()> {
     }
     for &(path, bytes) in files {
         if path.as_os_str() == "-" {
-            let mut out = std::io::stdout().lock();
-            out.write_all(bytes).map_err(|e| Error::io("<stdout>", e))?;
-            out.flush().map_err(|e| Error::io("<stdout>", e))?;
+            let fail = |e| Error::io("<stdout>", e);
+            let mut out = stdout()?;
+            out.write_all(bytes).map_err(fail)?;
+            out.flush().map_err(fail)?;
         }
     }
     for (path, tmp) in staged {
@@ -118,6 +141,42 @@ pub fn write_all_atomic(files: &[(&Path, &[u8])]) -> Result<()> {
             .map_err(|e| Error::io(path, std::io::Error::from(e.error.kind())))?;
     }
     Ok(())
+}
+
+/// Standard output to write a result to, or an error when the command was
+/// started with standard output closed (`flourish … -o - >&-`): the Rust
+/// runtime then opens `/dev/null` read-write in its place before `main`,
+/// where a shell's `> /dev/null` opens it write-only, so the result would
+/// vanish with a success.
+fn stdout() -> Result<std::io::StdoutLock<'static>> {
+    #[cfg(target_os = "linux")]
+    {
+        let target = std::fs::read_link("/proc/self/fd/1").ok();
+        let flags = std::fs::read_to_string("/proc/self/fdinfo/1")
+            .ok()
+            .and_then(|t| {
+                t.lines()
+                    .find_map(|l| l.strip_prefix("flags:"))
+                    .and_then(|f| u32::from_str_radix(f.trim(), 8).ok())
+            });
+        const O_ACCMODE: u32 = 0o3;
+        const O_RDWR: u32 = 0o2;
+        if target.as_deref() == Some(Path::new("/dev/null"))
+            && flags.is_some_and(|f| f & O_ACCMODE == O_RDWR)
+        {
+            return Err(Error::io(
+                "<stdout>",
+                std::io::Error::new(std::io::ErrorKind::BrokenPipe, "standard output is closed"),
+            ));
+        }
+    }
+    Ok(std::io::stdout().lock())
+}
+
+/// Whether `path` is a regular file, following symbolic links (a FIFO or a
+/// device would block or never end when opened; a folder is not a file).
+pub(crate) fn is_regular_file(path: &Path) -> bool {
+    std::fs::metadata(path).is_ok_and(|m| m.is_file())
 }
 
 /// True when `a` and `b` name the same existing file (or the same path).

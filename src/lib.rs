@@ -59,7 +59,7 @@ pub use brush::{BrushOptions, Refinement, MAX_ITERATIONS};
 pub use diff::DiffReport;
 pub use error::{Error, Result};
 pub use fill::FillOptions;
-pub use library::{Library, Style, StyleOptions, Styles};
+pub use library::{Library, Style, StyleEntry, StyleOptions, Styles, STYLES_ENV};
 pub use pattern::PatternOptions;
 pub use read::sketch::{Query, QueryKind, Sketch};
 pub use read::style::StyleKind;
@@ -93,7 +93,8 @@ pub fn brush<'a>(
     styles: impl Into<Styles<'a>>,
     opts: &BrushOptions,
 ) -> Result<Output> {
-    brush::run(styles.into().default_style().brush()?, sketch, opts)
+    let style = styles.into().default_style().brush()?;
+    in_px(sketch, |sk| brush::run(style, sk, opts)).map(finish)
 }
 
 /// Fills every filled shape of `sketch` with an art pattern synthesized
@@ -120,19 +121,34 @@ pub fn fill<'a>(
     opts: &FillOptions,
 ) -> Result<Output> {
     let styles = styles.into();
-    let out = fill::fill_sketch(
-        sketch,
-        |q| {
-            let s = styles.of(q)?;
-            Ok((s.name(), s.fill()?))
-        },
-        opts,
-    )?;
-    Ok(Output {
-        document: out.to_document(),
-        warnings: Vec::new(),
-        notes: out.notes,
-    })
+    // A direction sketch overlays the sketch: the same units.
+    let k = sketch.px_per_unit();
+    let scaled;
+    let opts = if (k - 1.0).abs() > 1e-9 && opts.direction.is_some() {
+        scaled = FillOptions {
+            direction: opts.direction.as_ref().map(|d| d.scaled(k)),
+            ..opts.clone()
+        };
+        &scaled
+    } else {
+        opts
+    };
+    let out = in_px(sketch, |sk| {
+        let out = fill::fill_sketch(
+            sk,
+            |q| {
+                let s = styles.of(q)?;
+                Ok((s.name(), s.fill()?))
+            },
+            opts,
+        )?;
+        Ok(Output {
+            document: out.to_document(),
+            warnings: Vec::new(),
+            notes: out.notes,
+        })
+    })?;
+    Ok(finish(out))
 }
 
 /// Arranges the hand-drawn elements of a pattern style along every
@@ -159,8 +175,11 @@ pub fn pattern<'a>(
     opts: &PatternOptions,
 ) -> Result<Output> {
     let styles = styles.into();
-    let out = pattern::synthesize_sketch(sketch, |q| Ok(styles.of(q)?.pattern()?.clone()), opts)?;
-    Ok(Output::new(out.to_document()))
+    let out = in_px(sketch, |sk| {
+        let out = pattern::synthesize_sketch(sk, |q| Ok(styles.of(q)?.pattern()?.clone()), opts)?;
+        Ok(Output::new(out.to_document()))
+    })?;
+    Ok(finish(out))
 }
 
 /// A picture to trace: a raster (PNG, JPEG, BMP, GIF, TIFF, WebP) or an
@@ -198,7 +217,30 @@ impl Image {
 /// # }
 /// ```
 pub fn trace(image: &Image, opts: &TraceOptions) -> Result<Output> {
-    trace::trace(&image.picture, opts)
+    trace::trace(&image.picture, opts).map(finish)
+}
+
+/// Runs a mode on `sketch` in CSS pixels: a sketch drawn in millimetres
+/// or points is scaled to pixels first and the output scaled back, so
+/// styles (whose sizes are pixels) give the same drawing whatever the
+/// sketch's units.
+fn in_px(sketch: &Sketch, run: impl FnOnce(&Sketch) -> Result<Output>) -> Result<Output> {
+    let k = sketch.px_per_unit();
+    if (k - 1.0).abs() <= 1e-9 {
+        return run(sketch);
+    }
+    let mut out = run(&sketch.scaled(k))?;
+    out.document = out.document.rescaled(1.0 / k, sketch.view_box);
+    Ok(out)
+}
+
+/// A mode's output made safe to render: past [`svg_out::MAX_ELEMENTS`]
+/// paths, the shapes of a group painted alike are merged, with a note.
+fn finish(mut out: Output) -> Output {
+    if let Some(note) = out.document.merge_past_limit() {
+        out.notes.push(note);
+    }
+    out
 }
 
 /// Reads a folder of exemplar drawings (SVG or raster) for `flourish

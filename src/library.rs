@@ -87,7 +87,12 @@ impl Style {
     /// Loads the style in `dir`, known by `name` in notes.
     fn load_named_as(name: &str, dir: &Path, opts: &StyleOptions) -> Result<Style> {
         opts.validate()?;
+        let toml_path = dir.join(STYLE_FILE);
+        if !crate::io::is_regular_file(&toml_path) {
+            return Err(Error::invalid("not a regular file").in_file(toml_path));
+        }
         let manifest = toml::load(dir)?;
+        check_files(dir, &manifest)?;
         let kind = manifest.kind;
         if let Some(want) = opts.kind {
             wrong_kind(dir, kind, want)?;
@@ -172,6 +177,34 @@ impl Style {
     }
 }
 
+/// Checks that every exemplar `toml` lists is a regular file inside the
+/// style folder `dir` once symbolic links are followed: a link may not
+/// lead a style out of its folder (to `/etc/passwd`, say), and a FIFO or a
+/// device would block or never end when read. Errors name the key.
+fn check_files(dir: &Path, toml: &toml::StyleToml) -> Result<()> {
+    let toml_path = dir.join(STYLE_FILE);
+    let bad = |i: usize, why: String| {
+        Err(Error::invalid(format!("exemplar[{i}].file: {why}")).in_file(&toml_path))
+    };
+    let home = std::fs::canonicalize(dir).map_err(|e| Error::io(dir, e))?;
+    for (i, ex) in toml.exemplar.iter().enumerate() {
+        let path = dir.join(&ex.file);
+        let Ok(real) = std::fs::canonicalize(&path) else {
+            return bad(i, format!("{} does not exist", ex.file.display()));
+        };
+        if !real.starts_with(&home) {
+            return bad(
+                i,
+                format!("{} leads out of the style folder", ex.file.display()),
+            );
+        }
+        if !crate::io::is_regular_file(&real) {
+            return bad(i, format!("{} is not a regular file", ex.file.display()));
+        }
+    }
+    Ok(())
+}
+
 /// The error for a style of kind `is` where `want` is needed, naming its
 /// `style.toml`.
 fn wrong_kind(dir: &Path, is: StyleKind, want: StyleKind) -> Result<()> {
@@ -244,9 +277,52 @@ impl Library {
         }
     }
 
-    /// The styles shipped with flourish (the crate's `styles/` folder).
+    /// The styles shipped with flourish (they travel inside the binary).
     pub fn shipped() -> Library {
         Library::new([shipped_dir()])
+    }
+
+    /// The command line's search path: the folders `extra` (`--styles
+    /// DIR`), then those of `$FLOURISH_STYLES` (separated like `PATH`),
+    /// then the shipped styles.
+    pub fn search<P: Into<PathBuf>>(extra: impl IntoIterator<Item = P>) -> Library {
+        let mut dirs: Vec<PathBuf> = extra.into_iter().map(Into::into).collect();
+        if let Some(env) = std::env::var_os(STYLES_ENV) {
+            dirs.extend(std::env::split_paths(&env).filter(|d| !d.as_os_str().is_empty()));
+        }
+        dirs.push(shipped_dir());
+        Library { dirs }
+    }
+
+    /// Every style the library's folders hold, by name (a name found in an
+    /// earlier folder hides the same name in later ones), sorted by name.
+    pub fn styles(&self) -> Vec<StyleEntry> {
+        let mut seen: BTreeMap<String, StyleEntry> = BTreeMap::new();
+        for d in &self.dirs {
+            let Ok(entries) = std::fs::read_dir(d) else {
+                continue;
+            };
+            for e in entries.filter_map(|e| e.ok()) {
+                let dir = e.path();
+                let name = e.file_name().to_string_lossy().into_owned();
+                if seen.contains_key(&name) || !dir.join(STYLE_FILE).is_file() {
+                    continue;
+                }
+                let summary = std::fs::read_to_string(dir.join(STYLE_FILE))
+                    .ok()
+                    .and_then(|t| ::toml::from_str::<Summary>(&t).ok());
+                seen.insert(
+                    name.clone(),
+                    StyleEntry {
+                        name,
+                        kind: summary.as_ref().map(|s| s.kind),
+                        exemplars: summary.map_or(0, |s| s.exemplar.len()),
+                        dir,
+                    },
+                );
+            }
+        }
+        seen.into_values().collect()
     }
 
     /// The folder of `style`: `style` itself when it is a folder holding
@@ -269,7 +345,13 @@ impl Library {
             [a, b] => format!("neither {a} nor {b} exists"),
             _ => format!("none of {} exists", tried.join(", ")),
         };
-        Err(Error::invalid(format!("style not found: {tried}")).in_file(direct))
+        let close = close_names(style, &self.styles());
+        let hint = if close.is_empty() {
+            String::new()
+        } else {
+            format!(" (did you mean {}?)", close.join(", "))
+        };
+        Err(Error::invalid(format!("style not found: {tried}{hint}")).in_file(direct))
     }
 
     /// Finds `style` ([`Library::find`]) and loads it under that name.
@@ -339,9 +421,116 @@ impl Library {
     }
 }
 
-/// The crate's own `styles/` folder.
+/// One style of a library, as `flourish style list` shows it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StyleEntry {
+    /// Its folder's name, the name it is loaded by.
+    pub name: String,
+    /// Its folder.
+    pub dir: PathBuf,
+    /// What it is for (`None` when its `style.toml` does not say).
+    pub kind: Option<StyleKind>,
+    /// How many `[[exemplar]]` tables it lists.
+    pub exemplars: usize,
+}
+
+/// What `style list` reads of a `style.toml`, without checking the rest.
+#[derive(serde::Deserialize)]
+struct Summary {
+    kind: StyleKind,
+    #[serde(default)]
+    exemplar: Vec<::toml::Value>,
+}
+
+/// The names of `styles` close to `name`: at most two edits away (or
+/// three for long names), or holding it, best first.
+fn close_names(name: &str, styles: &[StyleEntry]) -> Vec<String> {
+    let wanted = name.rsplit('/').next().unwrap_or(name).to_lowercase();
+    let limit = if wanted.chars().count() > 8 { 3 } else { 2 };
+    let mut close: Vec<(usize, String)> = styles
+        .iter()
+        .filter_map(|s| {
+            let d = edits(&wanted, &s.name.to_lowercase());
+            let holds = !wanted.is_empty() && s.name.to_lowercase().contains(&wanted);
+            (d <= limit || holds).then(|| (d, s.name.clone()))
+        })
+        .collect();
+    close.sort();
+    close.into_iter().take(3).map(|(_, n)| n).collect()
+}
+
+/// The Levenshtein distance between `a` and `b`, in characters.
+fn edits(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut prev = row[0];
+        row[0] = i + 1;
+        for (j, &cb) in b.iter().enumerate() {
+            let next = (prev + usize::from(ca != cb))
+                .min(row[j] + 1)
+                .min(row[j + 1] + 1);
+            prev = row[j + 1];
+            row[j + 1] = next;
+        }
+    }
+    row[b.len()]
+}
+
+include!(concat!(env!("OUT_DIR"), "/shipped_styles.rs"));
+
+/// Environment variable holding more style folders, separated like `PATH`.
+pub const STYLES_ENV: &str = "FLOURISH_STYLES";
+
+/// The folder holding the shipped styles, which travel inside the binary:
+/// unpacked once into the cache folder (a folder per content, so an older
+/// or newer binary's stay as they were; written whole, then renamed into
+/// place), or into the temporary folder when there is no cache folder.
 pub(crate) fn shipped_dir() -> PathBuf {
-    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/styles"))
+    use std::sync::OnceLock;
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let base = directories::ProjectDirs::from("", "", "flourish")
+            .map(|p| p.cache_dir().to_path_buf())
+            .unwrap_or_else(|| std::env::temp_dir().join("flourish"));
+        let dir = base.join(format!("shipped-{SHIPPED_HASH:016x}"));
+        if dir.is_dir() || unpack(&base, &dir).is_ok() {
+            dir
+        } else {
+            // Unwritable cache: a private copy in the temporary folder.
+            let tmp = std::env::temp_dir().join(format!(
+                "flourish-shipped-{SHIPPED_HASH:016x}-{}",
+                std::process::id()
+            ));
+            let _ = unpack(&std::env::temp_dir(), &tmp);
+            tmp
+        }
+    })
+    .clone()
+}
+
+/// Writes the shipped styles into a fresh folder in `base` and renames it
+/// to `dir` (another process doing the same at once is harmless).
+fn unpack(base: &Path, dir: &Path) -> std::io::Result<()> {
+    std::fs::create_dir_all(base)?;
+    let tmp = tempfile::Builder::new()
+        .prefix(".shipped-")
+        .tempdir_in(base)?;
+    for (rel, bytes) in SHIPPED {
+        let path = tmp.path().join(rel);
+        if let Some(parent) = path.parent() {
+            std::fs::create_dir_all(parent)?;
+        }
+        std::fs::write(path, bytes)?;
+    }
+    match std::fs::rename(tmp.path(), dir) {
+        Ok(()) => {
+            let _ = tmp.keep();
+            Ok(())
+        }
+        Err(_) if dir.is_dir() => Ok(()),
+        Err(e) => Err(e),
+    }
 }
 
 #[cfg(test)]
@@ -382,6 +571,42 @@ mod tests {
             e.starts_with("q-2: data-style \"no-such-style\": style not found"),
             "{e}"
         );
+    }
+
+    /// A style's files are regular files inside its folder: a symbolic link
+    /// out of it, a FIFO and a missing exemplar are refused before anything
+    /// is read, naming the key.
+    #[cfg(unix)]
+    #[test]
+    fn style_files_stay_in_their_folder() {
+        let tmp = tempfile::tempdir().expect("temp dir");
+        let dir = tmp.path().join("s");
+        std::fs::create_dir_all(&dir).expect("folder");
+        let write_toml = |file: &str| {
+            std::fs::write(
+                dir.join(STYLE_FILE),
+                format!("kind = \"pattern\"\nscale = 2.0\n[[exemplar]]\nfile = \"{file}\"\n"),
+            )
+            .expect("writes");
+        };
+        let refused = |file: &str, why: &str| {
+            write_toml(file);
+            let e = Style::load(&dir, &StyleOptions::default())
+                .expect_err(file)
+                .to_string();
+            assert!(e.contains("exemplar[0].file") && e.contains(why), "{e}");
+        };
+        std::os::unix::fs::symlink("/etc/passwd", dir.join("passwd.svg")).expect("link");
+        refused("passwd.svg", "leads out of the style folder");
+        let fifo = dir.join("fifo.svg");
+        let made = std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .is_ok_and(|s| s.success());
+        if made {
+            refused("fifo.svg", "not a regular file");
+        }
+        refused("missing.svg", "does not exist");
     }
 
     /// A name is found in the first folder that holds it; one that no

@@ -41,7 +41,7 @@ enum Command {
     Fill(FillArgs),
     /// Grow structured ornament of a brush style along open paths (DecoBrush).
     Brush(BrushArgs),
-    /// Compare two SVGs by rendering; exit 1 when they differ beyond --tolerance.
+    /// Compare two SVGs by rendering: exit 0 alike, 1 different beyond --tolerance, 2 trouble.
     Diff(DiffArgs),
     /// Style libraries: analyse, report and draw diagnostics.
     Style(StyleArgs),
@@ -57,9 +57,18 @@ struct StyleArgs {
 enum StyleCommand {
     /// Analyse a brush library: a report per exemplar, warnings, and a diagnostics sheet.
     Check(StyleCheckArgs),
+    /// List every style that --styles, $FLOURISH_STYLES and the shipped styles hold.
+    List(StyleListArgs),
     /// Make a folder of exemplar drawings a brush library: write its style.toml, each
     /// exemplar's start and end found automatically.
     Init(StyleInitArgs),
+}
+
+#[derive(Args)]
+struct StyleListArgs {
+    /// A folder of styles searched first.
+    #[arg(long, value_name = "DIR")]
+    styles: Option<PathBuf>,
 }
 
 #[derive(Args)]
@@ -100,7 +109,7 @@ struct StyleCheckArgs {
 /// Where a command writes, shared by every mode that converts files.
 #[derive(Args)]
 struct Outputs {
-    /// Output SVG (`-` for standard output); one input only.
+    /// Output SVG (`-` for standard output, DIR/ for DIR/NAME.svg); one input only.
     #[arg(short = 'o', long = "output", value_name = "OUT.svg")]
     output: Option<PathBuf>,
     /// Output folder for a batch (made if missing): NAME.svg per input.
@@ -180,9 +189,9 @@ struct PatternArgs {
     styles: Option<PathBuf>,
     #[command(flatten)]
     out: Outputs,
-    /// Amount of variation between repeated elements, 0..1.
-    #[arg(long, default_value_t = 0.0, value_name = "0..1")]
-    variation: f64,
+    /// How much repeated elements vary in place and turn (Barla et al. §3.3), 0..1.
+    #[arg(long, alias = "variation", default_value_t = 0.0, value_name = "0..1")]
+    jitter: f64,
 }
 
 #[derive(Args)]
@@ -223,8 +232,23 @@ struct DiffArgs {
     out: Option<PathBuf>,
 }
 
+/// The argument parser's message on one line: its lines up to the usage
+/// summary, without tips, joined.
+fn one_line(e: &clap::Error) -> String {
+    let text = e.render().to_string();
+    let words: Vec<&str> = text
+        .lines()
+        .take_while(|l| !l.starts_with("Usage:"))
+        .filter(|l| !l.trim_start().starts_with("tip:"))
+        .flat_map(str::split_whitespace)
+        .collect();
+    words.join(" ").trim_start_matches("error: ").to_string()
+}
+
 /// A failure and the exit status it maps to.
 enum Failure {
+    /// `diff` could not compare (as `cmp` and `diff` do): exit 2.
+    Trouble(Error),
     Usage(String),
     Run(Error),
     Differ,
@@ -246,10 +270,14 @@ impl From<Error> for Failure {
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(c) => c,
+        Err(e) if e.use_stderr() => {
+            eprintln!("flourish: {} (see flourish --help)", one_line(&e));
+            return ExitCode::from(2);
+        }
         Err(e) => {
-            let code = if e.use_stderr() { 2 } else { 0 };
+            // --help and --version.
             let _ = e.print();
-            return ExitCode::from(code);
+            return ExitCode::SUCCESS;
         }
     };
     match run(cli) {
@@ -263,6 +291,10 @@ fn main() -> ExitCode {
             ExitCode::from(1)
         }
         Err(Failure::Differ) => ExitCode::from(1),
+        Err(Failure::Trouble(e)) => {
+            eprintln!("flourish: {e}");
+            ExitCode::from(2)
+        }
     }
 }
 
@@ -295,6 +327,9 @@ fn run(cli: Cli) -> Result<(), Failure> {
             command: StyleCommand::Check(args),
         }) => run_style_check(args, cli.quiet),
         Command::Style(StyleArgs {
+            command: StyleCommand::List(args),
+        }) => run_style_list(args),
+        Command::Style(StyleArgs {
             command: StyleCommand::Init(args),
         }) => run_style_init(args, cli.quiet),
     }
@@ -313,10 +348,10 @@ fn run_trace(args: TraceArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
     opts.validate()?;
     input.validate()?;
     let job = |inp: &Path| -> Result<String, Error> {
-        let bytes = io::read_file(inp)?;
+        let bytes = io::read_input(inp)?;
         let out = Image::from_bytes(&bytes, &input)
             .and_then(|image| flourish::trace(&image, &opts))
-            .map_err(|e| e.in_file(inp))?;
+            .map_err(|e| e.in_file(shown(inp)))?;
         Ok(report(inp, out, quiet, verbose))
     };
     run_batch(&args.inputs, &args.out, quiet, &job)
@@ -325,6 +360,7 @@ fn run_trace(args: TraceArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
 /// Prints what a run has to tell about input `inp` (warnings unless
 /// `quiet`, notes under `verbose`) and gives its SVG.
 fn report(inp: &Path, out: Output, quiet: bool, verbose: bool) -> String {
+    let inp = shown(inp);
     if !quiet {
         for w in &out.warnings {
             eprintln!("flourish: warning: {}: {w}", inp.display());
@@ -342,6 +378,7 @@ fn report(inp: &Path, out: Output, quiet: bool, verbose: bool) -> String {
 /// notes under `verbose`.
 fn load_sketch(path: &Path, quiet: bool, verbose: bool) -> Result<Sketch, Error> {
     let sk = read_sketch(path)?;
+    let path = shown(path);
     if !quiet {
         for w in &sk.warnings {
             eprintln!("flourish: warning: {}: {w}", path.display());
@@ -355,9 +392,18 @@ fn load_sketch(path: &Path, quiet: bool, verbose: bool) -> Result<Sketch, Error>
     Ok(sk)
 }
 
-/// Reads and parses a sketch file; errors name it.
+/// Reads and parses a sketch file (`-`: standard input); errors name it.
 fn read_sketch(path: &Path) -> Result<Sketch, Error> {
-    Sketch::from_svg(&io::read_file(path)?).map_err(|e| e.in_file(path))
+    Sketch::from_svg(&io::read_input(path)?).map_err(|e| e.in_file(shown(path)))
+}
+
+/// How an input is named in messages: `-` as `<stdin>`.
+fn shown(path: &Path) -> &Path {
+    if path.as_os_str() == "-" {
+        Path::new("<stdin>")
+    } else {
+        path
+    }
 }
 
 /// Makes output folder `dir` (and its parents) unless it exists; a file
@@ -377,18 +423,16 @@ fn make_folder(dir: &Path) -> Result<(), Failure> {
     })
 }
 
-/// The `--styles` folder, or the shipped styles.
+/// The search path for style names: `--styles DIR`, then
+/// `$FLOURISH_STYLES`, then the shipped styles.
 fn library(arg: &Option<PathBuf>) -> Library {
-    match arg {
-        Some(dir) => Library::new([dir.clone()]),
-        None => Library::shipped(),
-    }
+    Library::search(arg.iter().cloned())
 }
 
 fn run_pattern(args: PatternArgs, quiet: bool, verbose: bool) -> Result<(), Failure> {
     let opts = PatternOptions {
         seed: args.out.seed,
-        variation: args.variation,
+        variation: args.jitter,
         ..PatternOptions::default()
     };
     opts.validate()?;
@@ -403,7 +447,7 @@ fn run_pattern(args: PatternArgs, quiet: bool, verbose: bool) -> Result<(), Fail
         let out = lib
             .load_named(&sk, StyleKind::Pattern, &load)
             .and_then(|named| flourish::pattern(&sk, Styles::new(&style, &named), &opts))
-            .map_err(|e| e.in_file(sketch))?;
+            .map_err(|e| e.in_file(shown(sketch)))?;
         Ok(report(sketch, out, quiet, verbose))
     };
     run_batch(&args.sketches, &args.out, quiet, &job)
@@ -444,7 +488,7 @@ fn run_fill(args: FillArgs, quiet: bool, verbose: bool) -> Result<(), Failure> {
         let out = lib
             .load_named(&sk, StyleKind::Fill, &load)
             .and_then(|named| flourish::fill(&sk, Styles::new(&style, &named), &opts))
-            .map_err(|e| e.in_file(sketch))?;
+            .map_err(|e| e.in_file(shown(sketch)))?;
         Ok(report(sketch, out, quiet, verbose))
     };
     run_batch(&args.sketches, &args.out, quiet, &job)
@@ -469,7 +513,7 @@ fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
     }
     let refine = match &args.refine {
         Some(path) => {
-            Some(Refinement::from_svg(&io::read_file(path)?).map_err(|e| e.in_file(path))?)
+            Some(Refinement::from_svg(&io::read_input(path)?).map_err(|e| e.in_file(shown(path)))?)
         }
         None => None,
     };
@@ -492,7 +536,7 @@ fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
         };
         let job = |sketch: &Path| -> Result<String, Error> {
             let sk = load_sketch(sketch, quiet, verbose)?;
-            let out = flourish::brush(&sk, &style, &opts).map_err(|e| e.in_file(sketch))?;
+            let out = flourish::brush(&sk, &style, &opts).map_err(|e| e.in_file(shown(sketch)))?;
             Ok(report(sketch, out, quiet, verbose))
         };
         let suffixed = |p: &Path| -> PathBuf {
@@ -568,6 +612,21 @@ fn run_jobs(
                 ));
             }
             let inp = &inputs[0];
+            // `-o DIR/` (or an existing folder) writes NAME.svg into it.
+            let into = |p: &Path, name: PathBuf| -> Result<PathBuf, Failure> {
+                if names_folder(p) {
+                    make_folder(p)?;
+                    Ok(p.join(name))
+                } else {
+                    Ok(p.to_path_buf())
+                }
+            };
+            let out = &into(out, svg_name(inp))?;
+            let preview = match preview {
+                Some(p) => Some(into(p, png_name(inp))?),
+                None => None,
+            };
+            let preview = preview.as_deref();
             check_not_input(inp, out)?;
             if let Some(p) = preview {
                 check_not_input(inp, p)?;
@@ -586,8 +645,27 @@ fn run_jobs(
             Ok(())
         }
         (None, Some(dir)) => {
-            // Output folders are made as needed, like `mkdir -p`.
+            // Output folders are made as needed, like `mkdir -p`. A preview
+            // that names a PNG file serves a batch of one.
             make_folder(dir)?;
+            let preview_file = preview.filter(|p| !names_folder(p) && is_png_name(p));
+            match (preview_file, inputs.len()) {
+                (Some(p), 1) => {
+                    check_not_input(&inputs[0], p)?;
+                    let svg = job(&inputs[0])?;
+                    let out = dir.join(svg_name(&inputs[0]));
+                    check_not_input(&inputs[0], &out)?;
+                    write_outputs(&out, &svg, Some(p))?;
+                    return Ok(());
+                }
+                (Some(p), _) => {
+                    return Err(Failure::Usage(format!(
+                        "--preview {} names a file; with several inputs it names a folder",
+                        p.display()
+                    )))
+                }
+                (None, _) => {}
+            }
             if let Some(p) = preview {
                 make_folder(p)?;
             }
@@ -652,10 +730,25 @@ fn write_outputs(out: &Path, svg: &str, preview: Option<&Path>) -> Result<(), Er
     }
 }
 
-/// The output file name of an input in an `--out-dir`: its stem, `-vK`
-/// for variation K, and the extension.
+/// Whether an output path names a folder: it ends in a separator or is
+/// one already.
+fn names_folder(p: &Path) -> bool {
+    p.as_os_str() != "-" && (p.as_os_str().to_string_lossy().ends_with('/') || p.is_dir())
+}
+
+/// Whether a path's extension is `.png`.
+fn is_png_name(p: &Path) -> bool {
+    p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"))
+}
+
+/// The output file name of an input in an `--out-dir`: its stem (`stdin`
+/// for `-`), `-vK` for variation K, and the extension.
 fn named(inp: &Path, variant: Option<u32>, ext: &str) -> PathBuf {
-    let mut stem = inp.file_stem().unwrap_or_default().to_os_string();
+    let mut stem = if inp.as_os_str() == "-" {
+        std::ffi::OsString::from("stdin")
+    } else {
+        inp.file_stem().unwrap_or_default().to_os_string()
+    };
     if let Some(k) = variant {
         stem.push(format!("-v{k}"));
     }
@@ -663,7 +756,7 @@ fn named(inp: &Path, variant: Option<u32>, ext: &str) -> PathBuf {
 }
 
 fn check_not_input(input: &Path, output: &Path) -> Result<(), Failure> {
-    if output.as_os_str() != "-" && io::same_file(input, output) {
+    if output.as_os_str() != "-" && input.as_os_str() != "-" && io::same_file(input, output) {
         return Err(Failure::Run(
             Error::invalid("output would overwrite the input").in_file(output),
         ));
@@ -678,21 +771,35 @@ fn run_diff(args: DiffArgs, quiet: bool) -> Result<(), Failure> {
             args.tolerance
         )));
     }
+    let trouble = |f: Failure| match f {
+        Failure::Run(e) => Failure::Trouble(e),
+        f => f,
+    };
     if let Some(out) = &args.out {
-        check_not_input(&args.expected, out)?;
-        check_not_input(&args.actual, out)?;
+        check_not_input(&args.expected, out).map_err(trouble)?;
+        check_not_input(&args.actual, out).map_err(trouble)?;
     }
-    let report = flourish::diff(&args.expected, &args.actual)?;
+    let report = flourish::diff(&args.expected, &args.actual).map_err(Failure::Trouble)?;
     if let Some(out) = &args.out {
-        io::write_atomic(out, &report.panels_png().map_err(|e| e.in_file(out))?)?;
+        report
+            .panels_png()
+            .map_err(|e| e.in_file(out))
+            .and_then(|png| io::write_atomic(out, &png))
+            .map_err(Failure::Trouble)?;
     }
     if !quiet {
-        println!(
+        let line = format!(
             "changed: {:.6} ({} of {} px)",
             report.fraction(),
             report.changed,
             report.total
         );
+        // The image alone goes to standard output when it is asked for there.
+        if args.out.as_deref() == Some(Path::new("-")) {
+            eprintln!("{line}");
+        } else {
+            println!("{line}");
+        }
     }
     if report.fraction() > args.tolerance {
         return Err(Failure::Differ);
@@ -762,6 +869,30 @@ fn run_style_check(args: StyleCheckArgs, quiet: bool) -> Result<(), Failure> {
     }
     if args.strict && report.warning_count() > 0 {
         return Err(Failure::Differ);
+    }
+    Ok(())
+}
+
+fn run_style_list(args: StyleListArgs) -> Result<(), Failure> {
+    let styles = library(&args.styles).styles();
+    let width = styles
+        .iter()
+        .map(|s| s.name.len())
+        .max()
+        .unwrap_or(4)
+        .max(4);
+    println!(
+        "{:width$}  {:7}  {:>9}  folder",
+        "name", "kind", "exemplars"
+    );
+    for s in &styles {
+        let kind = s.kind.map_or("?", StyleKind::name);
+        println!(
+            "{:width$}  {kind:7}  {:>9}  {}",
+            s.name,
+            s.exemplars,
+            s.dir.display()
+        );
     }
     Ok(())
 }

@@ -143,6 +143,71 @@ pub struct Document {
     pub decimals: u32,
 }
 
+/// Most `<path>` elements an output holds before the shapes of a group
+/// that look alike are merged (renderers refuse documents of a million
+/// elements; rsvg's limit).
+pub const MAX_ELEMENTS: usize = 200_000;
+
+impl Document {
+    /// The document with its drawing scaled by `f` and its view box set
+    /// to `view_box`: every path and stroke width, with the decimals
+    /// that keep the same precision.
+    pub(crate) fn rescaled(mut self, f: f64, view_box: Rect) -> Document {
+        let to = kurbo::Affine::scale(f);
+        for g in &mut self.groups {
+            for s in &mut g.shapes {
+                s.path.apply_affine(to);
+                if let Some(st) = &mut s.stroke {
+                    st.width *= f;
+                }
+            }
+        }
+        self.view_box = view_box;
+        let more = (-f.log10()).ceil();
+        if more.is_finite() && more > 0.0 {
+            self.decimals = (self.decimals + more as u32).min(15);
+        }
+        self
+    }
+
+    /// Merges the shapes of each group that share fill, fill rule, stroke
+    /// and opacity into one path each, when the document holds more than
+    /// [`MAX_ELEMENTS`] shapes; returns the note saying so, if it did. The
+    /// drawing is unchanged: the shapes' subpaths keep their own
+    /// orientation, so holes stay holes under their fill rule.
+    pub fn merge_past_limit(&mut self) -> Option<String> {
+        let before: usize = self.groups.iter().map(|g| g.shapes.len()).sum();
+        if before <= MAX_ELEMENTS {
+            return None;
+        }
+        for g in &mut self.groups {
+            let mut merged: Vec<Shape> = Vec::new();
+            for s in g.shapes.drain(..) {
+                match merged.iter_mut().find(|m| m.looks_like(&s)) {
+                    Some(m) => m.path.extend(s.path),
+                    None => merged.push(s),
+                }
+            }
+            g.shapes = merged;
+        }
+        let after: usize = self.groups.iter().map(|g| g.shapes.len()).sum();
+        Some(format!(
+            "{before} shapes merged into {after} paths (one per colour and group), under the limit of {MAX_ELEMENTS} elements"
+        ))
+    }
+}
+
+impl Shape {
+    /// Whether `other` is painted the same way (fill, rule, stroke,
+    /// opacity), so both can be one path.
+    fn looks_like(&self, other: &Shape) -> bool {
+        self.fill == other.fill
+            && self.fill_rule == other.fill_rule
+            && self.stroke == other.stroke
+            && self.opacity == other.opacity
+    }
+}
+
 /// What a mode makes of its input: the document, and what to tell the
 /// user about it.
 #[derive(Clone, Debug)]
@@ -208,8 +273,19 @@ impl Document {
     /// Serializes the document.
     pub fn to_svg(&self) -> String {
         let mut out = String::with_capacity(4096);
-        let d = self.decimals.max(2);
         let vb = &self.view_box;
+        // Sizes keep four significant digits however small the document
+        // (a size rounded to 0 is an SVG renderers refuse).
+        let smallest = [self.width, self.height, vb.width(), vb.height()]
+            .into_iter()
+            .filter(|v| *v > 0.0 && v.is_finite())
+            .fold(f64::INFINITY, f64::min);
+        let needed = if smallest.is_finite() {
+            (4.0 - smallest.log10().floor() - 1.0).clamp(0.0, 15.0) as u32
+        } else {
+            0
+        };
+        let d = self.decimals.max(2).max(needed);
         let _ = writeln!(
             out,
             "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{}\" height=\"{}\" viewBox=\"{} {} {} {}\">",
@@ -528,6 +604,48 @@ fn is_straight(p0: Point, p1: Point, p2: Point, p3: Point, eps: f64) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A document a ten-thousandth of a unit high keeps its size (four
+    /// significant digits), so renderers accept it.
+    #[test]
+    fn tiny_documents_keep_their_size() {
+        let doc = Document::new(0.0001, 0.00025, 2);
+        let svg = doc.to_svg();
+        assert!(
+            svg.contains(r#"width=".0001" height=".00025" viewBox="0 0 .0001 .00025""#),
+            "{svg}"
+        );
+    }
+
+    /// Past the element limit, the shapes of a group painted alike become
+    /// one path each (their subpaths kept), and it is said.
+    #[test]
+    fn shapes_past_the_limit_are_merged_per_colour() {
+        let mut doc = Document::new(10.0, 10.0, 2);
+        let square = |x: f64| kurbo::Shape::to_path(&kurbo::Rect::new(x, 0.0, x + 1.0, 1.0), 0.1);
+        let (a, b) = (Color::rgb(1, 2, 3), Color::rgb(4, 5, 6));
+        doc.groups.push(Group {
+            id: "q".into(),
+            shapes: (0..MAX_ELEMENTS + 2)
+                .map(|i| Shape::filled(square(i as f64 % 8.0), if i % 2 == 0 { a } else { b }))
+                .collect(),
+        });
+        let note = doc.merge_past_limit().expect("merged");
+        assert!(note.contains("into 2 paths"), "{note}");
+        assert_eq!(doc.groups[0].shapes.len(), 2);
+        let moves = |s: &Shape| {
+            s.path
+                .elements()
+                .iter()
+                .filter(|e| matches!(e, kurbo::PathEl::MoveTo(_)))
+                .count()
+        };
+        assert_eq!(
+            moves(&doc.groups[0].shapes[0]) + moves(&doc.groups[0].shapes[1]),
+            MAX_ELEMENTS + 2
+        );
+        assert!(doc.merge_past_limit().is_none(), "under the limit now");
+    }
 
     #[test]
     fn numbers_are_compact() {

@@ -125,6 +125,26 @@ fn assert_failure(o: &Output, file: &Path, causes: &[&str]) {
     }
 }
 
+/// `diff` could not compare: exit 2 and one line naming the file.
+#[track_caller]
+fn assert_trouble(o: &Output, file: &Path, causes: &[&str]) {
+    let err = stderr(o);
+    assert_eq!(code(o), Some(2), "expected exit 2; stderr: {err}");
+    let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "expected one line on stderr, got: {err:?}");
+    let name = file.file_name().unwrap().to_str().unwrap();
+    assert!(
+        lines[0].contains(name),
+        "stderr does not name {name}: {err:?}"
+    );
+    for c in causes {
+        assert!(
+            lines[0].contains(c),
+            "stderr does not mention {c:?}: {err:?}"
+        );
+    }
+}
+
 /// A usage error: exit 2 and something on stderr, nothing on stdout.
 #[track_caller]
 fn assert_usage(o: &Output, mention: &str) {
@@ -957,6 +977,81 @@ fn unknown_flag_is_a_usage_error() {
     assert_eq!(code(&o), Some(2), "no subcommand: stderr {}", stderr(&o));
 }
 
+/// Every usage error is one line on stderr, the argument parser's too.
+#[test]
+fn usage_errors_are_one_line() {
+    let t = tempdir();
+    let a = t.path().join("a.png");
+    write_disc_png(&a, 16);
+    for args in [
+        vec!["trace", s(&a), "--frobnicate"],
+        vec!["trace"],
+        vec!["frobnicate"],
+        vec!["trace", s(&a), "--tolerance", "lots"],
+        vec![],
+    ] {
+        let o = flourish(&args);
+        assert_eq!(code(&o), Some(2), "{args:?}: {}", stderr(&o));
+        assert_eq!(stderr(&o).lines().count(), 1, "{args:?}: {}", stderr(&o));
+        assert!(stderr(&o).starts_with("flourish: "), "{}", stderr(&o));
+    }
+}
+
+/// A result for standard output with standard output closed, or read by
+/// no one, is a failure, exit 1, not a silent success; `> /dev/null` is a
+/// success.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_closed_standard_output_fails_the_run() {
+    let t = tempdir();
+    let a = t.path().join("a.png");
+    write_disc_png(&a, 16);
+    let run = |redirect: &str| {
+        Command::new("bash")
+            .args([
+                "-c",
+                &format!("set -o pipefail; \"$0\" trace \"$1\" -o - {redirect}"),
+                BIN,
+                s(&a),
+            ])
+            .stdin(Stdio::null())
+            .output()
+            .expect("run bash")
+    };
+    for redirect in [">&-", "| (exec 0<&-; sleep 1)"] {
+        let o = run(redirect);
+        assert_eq!(code(&o), Some(1), "{redirect}: stderr: {}", stderr(&o));
+        assert_eq!(stderr(&o).lines().count(), 1, "{}", stderr(&o));
+        assert!(stderr(&o).contains("<stdout>"), "{}", stderr(&o));
+    }
+    let o = run("> /dev/null");
+    assert_eq!(code(&o), Some(0), "stderr: {}", stderr(&o));
+}
+
+/// An SVG whose entities would expand quadratically (a 100 kB entity
+/// referenced 20 000 times: 2 GB from 160 kB) is refused at once, in one
+/// line, without the memory it would take.
+#[test]
+fn entities_that_would_fill_memory_are_refused() {
+    let t = tempdir();
+    let svg = t.path().join("lol.svg");
+    let text = format!(
+        r#"<?xml version="1.0"?><!DOCTYPE svg [<!ENTITY a "{}">]><svg xmlns="http://www.w3.org/2000/svg" width="10" height="10"><text>{}</text></svg>"#,
+        "x".repeat(100_000),
+        "&a;".repeat(20_000)
+    );
+    std::fs::write(&svg, text).expect("write");
+    let out = t.path().join("out.svg");
+    for cmd in [
+        vec!["trace", s(&svg), "-o", s(&out)],
+        vec!["pattern", s(&svg), "-o", s(&out)],
+    ] {
+        let o = flourish_capped(t.path(), &cmd, 1024);
+        assert_failure(&o, &svg, &["entities expand"]);
+        assert!(!out.exists());
+    }
+}
+
 #[test]
 fn help_and_version_succeed() {
     let o = flourish(&["--help"]);
@@ -1277,6 +1372,29 @@ fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     p
 }
 
+/// `diff` given a picture says it compares SVG documents (exit 2); with
+/// `--out -` only the three-panel PNG goes to standard output.
+#[test]
+fn diff_refuses_pictures_and_keeps_stdout_for_the_image() {
+    let t = tempdir();
+    let a = write(
+        t.path(),
+        "a.svg",
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="100" height="50"><rect width="40" height="40"/></svg>"#,
+    );
+    let png = t.path().join("p.png");
+    write_disc_png(&png, 16);
+    let o = flourish(&["diff", s(&png), s(&a)]);
+    assert_trouble(&o, &png, &["not an SVG document"]);
+    let o = flourish(&["diff", s(&a), s(&a), "--out", "-"]);
+    assert_eq!(code(&o), Some(0), "stderr: {}", stderr(&o));
+    assert!(
+        o.stdout.starts_with(b"\x89PNG"),
+        "stdout is not the PNG alone"
+    );
+    assert!(stderr(&o).contains("changed: 0"), "{}", stderr(&o));
+}
+
 #[test]
 fn diff_identical_files_exit_zero() {
     let t = tempdir();
@@ -1357,7 +1475,7 @@ fn diff_different_sizes_fail_with_clear_message() {
     let b = write(t.path(), "tall.svg", SQUARE_SVG_TALL);
     let d = t.path().join("d.png");
     let o = flourish(&["diff", s(&a), s(&b), "--out", s(&d)]);
-    assert_failure(&o, &b, &["size"]);
+    assert_trouble(&o, &b, &["size"]);
     assert!(!d.exists());
 }
 
@@ -1388,7 +1506,7 @@ fn diff_bad_inputs_fail_cleanly() {
         (&missing, &a, &missing),
     ] {
         let o = flourish(&["diff", s(x), s(y), "--out", s(&d)]);
-        assert_failure(&o, bad, &[]);
+        assert_trouble(&o, bad, &[]);
         assert_eq!(
             std::fs::read(&d).unwrap(),
             SENTINEL,
@@ -1406,7 +1524,7 @@ fn diff_out_in_missing_folder_fails_cleanly() {
     let a = write(t.path(), "a.svg", SQUARE_SVG);
     let d = t.path().join("nope").join("d.png");
     let o = flourish(&["diff", s(&a), s(&a), "--out", s(&d)]);
-    assert_failure(&o, &d, &[]);
+    assert_trouble(&o, &d, &[]);
     assert!(!d.exists());
 }
 
@@ -1418,14 +1536,14 @@ fn diff_out_equal_to_an_input_is_refused() {
     let b = write(t.path(), "b.svg", SQUARE_SVG_MOVED);
     for (out, text) in [(&a, SQUARE_SVG), (&b, SQUARE_SVG_MOVED)] {
         let o = flourish(&["diff", s(&a), s(&b), "--out", s(out)]);
-        assert_failure(&o, out, &["overwrite"]);
+        assert_trouble(&o, out, &["overwrite"]);
         assert_eq!(std::fs::read_to_string(out).unwrap(), text, "input changed");
         assert!(o.stdout.is_empty(), "stdout: {}", stdout(&o));
     }
     // Through another spelling of the same path.
     let other = t.path().join(".").join("b.svg");
     let o = flourish(&["diff", s(&a), s(&b), "--out", s(&other)]);
-    assert_failure(&o, &b, &["overwrite"]);
+    assert_trouble(&o, &b, &["overwrite"]);
     assert_eq!(std::fs::read_to_string(&b).unwrap(), SQUARE_SVG_MOVED);
     assert_no_temp_files(t.path());
 }
@@ -1847,4 +1965,74 @@ fn verbose_trace_says_when_a_photos_light_was_evened_out() {
         !String::from_utf8_lossy(&o.stderr).contains("light"),
         "{o:?}"
     );
+}
+
+/// `-` reads standard input; `-o DIR/` writes DIR/NAME.svg (NAME `stdin`
+/// for standard input); a `--preview` ending in .png is a file, also with
+/// `--out-dir` and one input, and a usage error with several.
+#[test]
+fn dash_reads_stdin_and_output_paths_mean_what_they_say() {
+    let t = tempdir();
+    let a = t.path().join("a.png");
+    write_disc_png(&a, 24);
+    let o = Command::new(BIN)
+        .args(["trace", "-", "-o", "-"])
+        .stdin(std::fs::File::open(&a).expect("open"))
+        .output()
+        .expect("run");
+    assert_eq!(code(&o), Some(0), "stderr: {}", stderr(&o));
+    assert!(stdout(&o).contains("<path"), "{}", stdout(&o));
+    let dir = t.path().join("outs");
+    let o = flourish(&["trace", s(&a), "-o", &format!("{}/", s(&dir))]);
+    assert_eq!(code(&o), Some(0), "stderr: {}", stderr(&o));
+    assert!(dir.join("a.svg").is_file());
+    let batch = t.path().join("batch");
+    let p = batch.join("p.png");
+    let o = flourish(&["trace", s(&a), "--out-dir", s(&batch), "--preview", s(&p)]);
+    assert_eq!(code(&o), Some(0), "stderr: {}", stderr(&o));
+    assert!(p.is_file(), "--preview D/p.png is a file");
+    let b = t.path().join("b.png");
+    write_disc_png(&b, 24);
+    let o = flourish(&[
+        "trace",
+        s(&a),
+        s(&b),
+        "--out-dir",
+        s(&batch),
+        "--preview",
+        s(&p),
+    ]);
+    assert_usage(&o, "names a file");
+}
+
+/// `style list` shows every shipped style with its kind; an unknown
+/// style's error names the close ones.
+#[test]
+fn styles_are_listed_and_close_names_suggested() {
+    let o = flourish(&["style", "list"]);
+    assert_eq!(code(&o), Some(0), "stderr: {}", stderr(&o));
+    let list = stdout(&o);
+    for (name, kind) in [("vine", "brush"), ("knot", "fill"), ("stipple", "pattern")] {
+        assert!(
+            list.lines()
+                .any(|l| l.starts_with(name) && l.contains(kind)),
+            "{list}"
+        );
+    }
+    let t = tempdir();
+    let sketch = write(
+        t.path(),
+        "s.svg",
+        r##"<svg xmlns="http://www.w3.org/2000/svg" width="100" height="100"><circle cx="50" cy="50" r="40" fill="#000"/></svg>"##,
+    );
+    let o = flourish(&[
+        "fill",
+        "--style",
+        "knott",
+        s(&sketch),
+        "-o",
+        s(&t.path().join("o.svg")),
+    ]);
+    assert_eq!(code(&o), Some(1), "stderr: {}", stderr(&o));
+    assert!(stderr(&o).contains("did you mean knot"), "{}", stderr(&o));
 }

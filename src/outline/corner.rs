@@ -1,7 +1,6 @@
 //! Corners of a closed outline: where it turns sharply within a
 //! pixel-scale window. The fitters cut contours there, so cubics meet at an
-//! angle and sharp corners stay sharp ([`crate::trace::fit`],
-//! [`crate::trace::cover`]).
+//! angle and sharp corners stay sharp (the tracer's `fit` and `cover`).
 
 use kurbo::Point;
 

@@ -19,7 +19,7 @@
 //! within a tolerance of that (§2.4).
 //!
 //! [`Corridor::reaches`] is the acceptance test the fitter uses for binary
-//! outlines ([`crate::trace::cover`]): a curve point is acceptable when a
+//! outlines (the tracer's `cover`): a curve point is acceptable when a
 //! mixed cell lies within the tolerance of it.
 
 use super::paths::Bitmap;

@@ -117,7 +117,7 @@ pub struct OutlineLayer {
 pub enum LayerOutline {
     /// A binary layer's ink. Its paths are smoothed
     /// ([`crate::outline::smooth::smooth_loop`]) and fitted one at a time, in
-    /// parallel, by [`crate::trace::trace_bitmap`], with the corridor
+    /// parallel, by the tracer's `trace_bitmap`, with the corridor
     /// where its edge may lie ([`crate::outline::corridor`]); the smoothed loops
     /// are never all held at once.
     Bitmap(crate::outline::paths::Bitmap),

@@ -22,6 +22,11 @@ use kurbo::{Affine, BezPath, Rect, Shape as _};
 use resvg::usvg;
 use std::collections::BTreeMap;
 
+/// Largest coordinate magnitude of a query, user units: sizes, lengths and
+/// element counts are computed from the coordinates, and past this a
+/// drawing's numbers (an arc of 1e308) only make them overflow.
+pub const MAX_COORD: f64 = 1e9;
+
 /// Prefix of the ids given to shapes that carry `data-style` but no `id`.
 const PRIVATE_ID: &str = "flourish-ds-";
 
@@ -90,6 +95,42 @@ impl Sketch {
     pub fn from_svg(bytes: &[u8]) -> Result<Sketch> {
         parse(bytes)
     }
+
+    /// CSS pixels per user unit: how large the sketch's units are drawn
+    /// (3.78 for a sketch in millimetres, 1.33 in points, 1 in px). The
+    /// mean of the two axes' scales when its aspect is not kept.
+    pub fn px_per_unit(&self) -> f64 {
+        let (vw, vh) = (self.view_box.width(), self.view_box.height());
+        let k = ((self.width / vw) * (self.height / vh)).sqrt();
+        if k.is_finite() && k > 0.0 {
+            k
+        } else {
+            1.0
+        }
+    }
+
+    /// The sketch with its user units scaled by `k`: every query's
+    /// geometry and width, and the view box; the drawn size stays.
+    pub(crate) fn scaled(&self, k: f64) -> Sketch {
+        let to = kurbo::Affine::scale(k);
+        let mut out = self.clone();
+        out.view_box = Rect::new(
+            k * self.view_box.x0,
+            k * self.view_box.y0,
+            k * self.view_box.x1,
+            k * self.view_box.y1,
+        );
+        for q in &mut out.queries {
+            match &mut q.kind {
+                QueryKind::Path { spine, width } => {
+                    spine.apply_affine(to);
+                    *width *= k;
+                }
+                QueryKind::Region { outline, .. } => outline.apply_affine(to),
+            }
+        }
+        out
+    }
 }
 
 /// Reads and parses a sketch SVG file; errors name it.
@@ -141,12 +182,7 @@ const SHAPES: [&str; 7] = [
 /// Reads `viewBox`, `preserveAspectRatio` and `data-style` from the raw XML
 /// and gives styled shapes without an id a private one.
 fn preprocess(text: &str) -> Result<Preprocessed> {
-    let opts = usvg::roxmltree::ParsingOptions {
-        allow_dtd: true,
-        ..Default::default()
-    };
-    let doc = usvg::roxmltree::Document::parse_with_options(text, opts)
-        .map_err(|e| Error::Svg(e.to_string()))?;
+    let doc = crate::read::svg::parse_xml(text)?;
     let root = doc.root_element();
     let view_box = root.attribute("viewBox").and_then(parse_view_box);
     let aspect = root
@@ -266,6 +302,16 @@ fn add_path(p: &usvg::Path, to_user: Affine, styles: &BTreeMap<String, String>, 
     }
     let abs = to_user * affine_of(p.abs_transform());
     let geom = abs * to_bezpath(p.data(), usvg::Transform::identity());
+    let hull = geom.control_box();
+    let far = [hull.x0, hull.y0, hull.x1, hull.y1]
+        .into_iter()
+        .find(|v| v.is_nan() || v.abs() > MAX_COORD);
+    if let Some(v) = far.filter(|_| !geom.elements().is_empty()) {
+        sk.warnings.push(format!(
+            "{label} has a coordinate of {v:e}, beyond ±{MAX_COORD:e} units, and is skipped"
+        ));
+        return;
+    }
     if geom.elements().is_empty() || geom.bounding_box().area() == 0.0 && geom.perimeter(0.1) == 0.0
     {
         sk.warnings
@@ -340,5 +386,26 @@ mod tests {
         assert_eq!(s.queries[1].id, "q-2");
         assert_eq!(s.queries[1].style.as_deref(), Some("stipple"));
         assert!(matches!(s.queries[1].kind, QueryKind::Region { .. }));
+    }
+
+    /// A shape whose coordinates run past `MAX_COORD` (an arc of 1e308, a
+    /// point at 3.4e38) is skipped with a warning before anything is
+    /// measured on it; the rest of the sketch stays.
+    #[test]
+    fn far_coordinates_are_skipped_with_a_warning() {
+        let svg = r##"<svg xmlns="http://www.w3.org/2000/svg" width="100" height="100">
+            <path d="M10 10 L3.4e38 20" stroke="#000" stroke-width="2" fill="none"/>
+            <path d="M10 10 A1e308 1e308 0 0 1 1e308 30" fill="#000"/>
+            <path d="M10 50 L90 50" stroke="#000" stroke-width="2" fill="none"/>
+        </svg>"##;
+        let s = parse(svg.as_bytes()).unwrap();
+        assert_eq!(s.queries.len(), 1, "{:?}", s.warnings);
+        assert!(
+            s.warnings
+                .iter()
+                .any(|w| w.contains("3.39") && w.contains("beyond")),
+            "{:?}",
+            s.warnings
+        );
     }
 }

@@ -12,6 +12,10 @@ use crate::error::{Error, Result};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
+/// Most `[[exemplar]]` tables a style may list: each is analysed and held
+/// in memory, and a library of a hundred is already large.
+pub const MAX_EXEMPLARS: usize = 100;
+
 /// The file name of a style's description inside its folder.
 pub const STYLE_FILE: &str = "style.toml";
 
@@ -174,6 +178,15 @@ impl StyleToml {
     pub fn validate(&self, path: &Path) -> Result<()> {
         let bad =
             |key: &str, why: String| Err(Error::invalid(format!("{key}: {why}")).in_file(path));
+        if self.exemplar.len() > MAX_EXEMPLARS {
+            return bad(
+                "exemplar",
+                format!(
+                    "{} exemplars, more than the limit of {MAX_EXEMPLARS}",
+                    self.exemplar.len()
+                ),
+            );
+        }
         if let Some(r) = self.resolution {
             if !(64..=1024).contains(&r) {
                 return bad("resolution", format!("must be within 64..1024 px, got {r}"));

@@ -52,12 +52,126 @@ fn inflate_capped(data: &[u8], cap: u64) -> Result<Cow<'_, [u8]>> {
     Ok(Cow::Owned(out))
 }
 
+/// Most bytes the general entity references of a document may expand to
+/// (16 MiB): SVG editors declare a few namespace URIs as entities, while a
+/// few kilobytes of entities referenced many times over would fill memory
+/// before the parser's own guard (nesting depth, references per entity)
+/// notices.
+pub const MAX_ENTITY_EXPANSION: u64 = 16 << 20;
+
+/// Most XML nodes a document may hold (4 M): memory in proportion to the
+/// input, whatever its entities and nesting make of it.
+const MAX_NODES: u32 = 4 << 20;
+
+/// How many bytes the general entity references of XML `text` expand to:
+/// each entity declared in the internal DTD subset (`<!ENTITY name
+/// "value">`) is measured with the entities it refers to expanded, and
+/// every reference to it after the DTD counts that length. `None` when an
+/// entity refers to itself, directly or not.
+fn entity_expansion(text: &str) -> Option<u64> {
+    let Some(dtd) = text.find("<!DOCTYPE") else {
+        return Some(0);
+    };
+    let end = text[dtd..].find("]>").map_or(text.len(), |e| dtd + e + 2);
+    let subset = &text[dtd..end];
+    let mut values: Vec<(&str, &str)> = Vec::new();
+    let mut rest = subset;
+    while let Some(at) = rest.find("<!ENTITY") {
+        rest = rest[at + 8..].trim_start();
+        if rest.starts_with('%') {
+            continue; // A parameter entity: used in the DTD only.
+        }
+        let name_end = rest.find(|c: char| c.is_whitespace()).unwrap_or(rest.len());
+        let name = &rest[..name_end];
+        let after = rest[name_end..].trim_start();
+        let Some(q) = after.chars().next().filter(|&c| c == '"' || c == '\'') else {
+            continue; // An external entity: it has no value here.
+        };
+        let Some(close) = after[1..].find(q) else {
+            break;
+        };
+        values.push((name, &after[1..1 + close]));
+        rest = &after[1 + close..];
+    }
+    if values.is_empty() {
+        return Some(0);
+    }
+    let refs = |s: &str, name: &str| s.matches(&format!("&{name};")).count() as u64;
+    // Expanded lengths in an order where every entity comes after those it
+    // refers to (depth first); an entity met again while its own
+    // references are being measured is a cycle.
+    let n = values.len();
+    let mut len: Vec<Option<u64>> = vec![None; n];
+    let mut on_path = vec![false; n];
+    fn measure(
+        i: usize,
+        values: &[(&str, &str)],
+        refs: &dyn Fn(&str, &str) -> u64,
+        len: &mut [Option<u64>],
+        on_path: &mut [bool],
+    ) -> Option<u64> {
+        if let Some(l) = len[i] {
+            return Some(l);
+        }
+        if on_path[i] {
+            return None;
+        }
+        on_path[i] = true;
+        let v = values[i].1;
+        let mut total = v.len() as u64;
+        for (j, (name, _)) in values.iter().enumerate() {
+            let k = refs(v, name);
+            if k > 0 {
+                // Each `&name;` is replaced by its expansion.
+                let l = measure(j, values, refs, len, on_path)?;
+                total = total
+                    .saturating_sub(k * (name.len() as u64 + 2))
+                    .saturating_add(k.saturating_mul(l));
+            }
+        }
+        on_path[i] = false;
+        len[i] = Some(total);
+        Some(total)
+    }
+    for i in 0..n {
+        measure(i, &values, &refs, &mut len, &mut on_path)?;
+    }
+    let len: Vec<u64> = len.into_iter().map(|l| l.unwrap_or(0)).collect();
+    let body = &text[end..];
+    Some(values.iter().zip(&len).fold(0u64, |acc, ((n, _), &l)| {
+        acc.saturating_add(refs(body, n).saturating_mul(l))
+    }))
+}
+
+/// Parses XML text as every SVG of flourish is parsed: a DTD allowed (SVG
+/// editors write one), its entities measured first and refused past
+/// [`MAX_ENTITY_EXPANSION`], and at most 4 M nodes.
+pub fn parse_xml(text: &str) -> Result<usvg::roxmltree::Document<'_>> {
+    match entity_expansion(text) {
+        Some(n) if n <= MAX_ENTITY_EXPANSION => {}
+        Some(n) => {
+            return Err(Error::Svg(format!(
+                "its entities expand to {n} bytes, more than the limit of {MAX_ENTITY_EXPANSION}"
+            )))
+        }
+        None => return Err(Error::Svg("an entity refers to itself".into())),
+    }
+    let opts = usvg::roxmltree::ParsingOptions {
+        allow_dtd: true,
+        nodes_limit: MAX_NODES,
+        ..Default::default()
+    };
+    usvg::roxmltree::Document::parse_with_options(text, opts).map_err(|e| Error::Svg(e.to_string()))
+}
+
 /// Parses SVG bytes (plain or SVGZ, see [`inflate_svgz`]) with
-/// [`svg_options`].
+/// [`svg_options`], the XML read by [`parse_xml`].
 pub fn parse_svg(data: &[u8]) -> Result<usvg::Tree> {
     let data = inflate_svgz(data)?;
+    let text = std::str::from_utf8(&data).map_err(|_| Error::Svg("not UTF-8 text".into()))?;
+    let doc = parse_xml(text)?;
     let tree =
-        usvg::Tree::from_data(&data, &svg_options()).map_err(|e| Error::Svg(e.to_string()))?;
+        usvg::Tree::from_xmltree(&doc, &svg_options()).map_err(|e| Error::Svg(e.to_string()))?;
     let size = tree.size();
     if !(size.width().is_finite() && size.height().is_finite()) {
         return Err(Error::invalid("SVG size is not finite"));
@@ -74,12 +188,8 @@ pub fn text_left_out(data: &[u8]) -> Option<&'static str> {
     if !text.contains("text") {
         return None;
     }
-    let opts = usvg::roxmltree::ParsingOptions {
-        allow_dtd: true,
-        ..Default::default()
-    };
     const SVG: &str = "http://www.w3.org/2000/svg";
-    let drawn = usvg::roxmltree::Document::parse_with_options(text, opts).is_ok_and(|doc| {
+    let drawn = parse_xml(text).is_ok_and(|doc| {
         doc.descendants().any(|n| {
             n.has_tag_name((SVG, "text")) && !n.ancestors().any(|a| a.has_tag_name((SVG, "defs")))
         })
@@ -153,6 +263,29 @@ fn mean_stop(stops: &[usvg::Stop]) -> Color {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Entities are measured before parsing: a namespace URI passes, a
+    /// large entity referenced many times and a cycle are refused, and
+    /// nested ones multiply.
+    #[test]
+    fn entities_are_measured_before_parsing() {
+        let ns = r#"<?xml version="1.0"?><!DOCTYPE svg [<!ENTITY ns_svg "http://www.w3.org/2000/svg">]><svg xmlns="&ns_svg;" width="4" height="4"/>"#;
+        assert_eq!(entity_expansion(ns), Some(26));
+        assert!(parse_svg(ns.as_bytes()).is_ok());
+        let big = format!(
+            r#"<!DOCTYPE svg [<!ENTITY a "{}">]><svg xmlns="http://www.w3.org/2000/svg"><text>{}</text></svg>"#,
+            "x".repeat(100_000),
+            "&a;".repeat(20_000)
+        );
+        assert_eq!(entity_expansion(&big), Some(2_000_000_000));
+        let e = parse_svg(big.as_bytes()).expect_err("refused").to_string();
+        assert!(e.contains("entities expand to 2000000000 bytes"), "{e}");
+        let nested = r#"<!DOCTYPE svg [<!ENTITY a "xy"><!ENTITY b '&a;&a;&a;'>]><svg>&b;&b;</svg>"#;
+        assert_eq!(entity_expansion(nested), Some(12));
+        let cycle = r#"<!DOCTYPE svg [<!ENTITY a "&b;"><!ENTITY b "&a;">]><svg>&a;</svg>"#;
+        assert_eq!(entity_expansion(cycle), None);
+        assert!(parse_svg(cycle.as_bytes()).is_err());
+    }
     use std::io::Write as _;
 
     fn gzip(data: &[u8]) -> Vec<u8> {

@@ -1077,3 +1077,33 @@ fn grainy_paper_keeps_hairlines_whole() {
         assert!(got >= clean_iou - 0.03, "grain ±{grain}: IoU {got:.4}");
     }
 }
+
+/// A dot of 2×2 pixels and a hole of 2×2 pixels, smoothed about a pixel
+/// round, trace to a few cubics (not polygon segments a tenth of a pixel
+/// long).
+#[test]
+fn small_dots_and_holes_trace_to_a_few_cubics() {
+    use crate::raster::{Coverage, Grid};
+    let dot: Coverage = Grid::from_fn(10, 10, |x, y| {
+        if (4..6).contains(&x) && (4..6).contains(&y) {
+            1.0
+        } else {
+            0.0
+        }
+    });
+    let hole: Coverage = dot.map(|c| if c > 0.5 { 0.0 } else { 1.0 });
+    for (name, cov) in [("dot", dot), ("hole", hole)] {
+        let loops = crate::outline::smooth::smooth_loops(&cov);
+        let small = loops
+            .iter()
+            .find(|l| l.points.iter().all(|p| (p.x - 5.0).abs() < 2.0))
+            .unwrap_or_else(|| panic!("{name}: no loop round the centre"));
+        let opts = TraceOptions {
+            min_area: 0.0,
+            ..TraceOptions::default()
+        };
+        let paths = super::trace_outline(std::slice::from_ref(small), None, &opts);
+        let segments: usize = paths.iter().map(|p| p.segments().count()).sum();
+        assert!(segments <= 4, "{name}: {segments} segments");
+    }
+}

@@ -142,14 +142,14 @@ pub fn read(path: &Path, key: &[u8; 32]) -> Read {
 /// Writes `style` for `key` to `path` atomically (creating the folder).
 pub fn write(path: &Path, key: &[u8; 32], style: &BrushStyle) -> Result<()> {
     if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir).map_err(|e| crate::Error::io(dir, e))?;
+        std::fs::create_dir_all(dir).map_err(|e| crate::error::Error::io(dir, e))?;
     }
     let mut bytes = Vec::with_capacity(1 << 20);
     bytes.extend_from_slice(MAGIC);
     bytes.extend_from_slice(&ANALYSIS_VERSION.to_le_bytes());
     bytes.extend_from_slice(key);
     let body = encode(style).map_err(|e| {
-        crate::Error::invalid(format!("cannot encode the analysis: {e}")).in_file(path)
+        crate::error::Error::invalid(format!("cannot encode the analysis: {e}")).in_file(path)
     })?;
     bytes.extend_from_slice(&body);
     io::write_atomic(path, &bytes)?;
