@@ -55,6 +55,7 @@ mod svg_out;
 mod trace;
 
 pub use brush::analysis::check::StyleReport;
+pub use brush::analysis::init::InitReport;
 pub use brush::{BrushOptions, Refinement, MAX_ITERATIONS};
 pub use diff::DiffReport;
 pub use error::{Error, Result};
@@ -480,6 +481,14 @@ fn finish(mut out: Output) -> Output {
         out.notes.push(note);
     }
     out
+}
+
+/// Reads a folder of exemplar drawings (SVG or raster) for `flourish
+/// style init`: each one's main branch ends found (the farthest pair
+/// along the edge-tangent-flow geodesic), at `resolution` px (default
+/// 256). [`InitReport::to_toml`] is the library's `style.toml`.
+pub fn init_style(dir: &Path, resolution: Option<u32>) -> Result<InitReport> {
+    brush::analysis::init::init(dir, resolution)
 }
 
 /// Analyses a brush style for `flourish style check`: a report per

@@ -65,6 +65,9 @@ enum StyleCommand {
     Check(StyleCheckArgs),
     /// List every style that --styles, $FLOURISH_STYLES and the shipped styles hold.
     List(StyleListArgs),
+    /// Make a folder of exemplar drawings a brush library: write its style.toml, each
+    /// exemplar's start and end found automatically.
+    Init(StyleInitArgs),
 }
 
 #[derive(Args)]
@@ -72,6 +75,19 @@ struct StyleListArgs {
     /// A folder of styles searched first.
     #[arg(long, value_name = "DIR")]
     styles: Option<PathBuf>,
+}
+
+#[derive(Args)]
+struct StyleInitArgs {
+    /// Folder of exemplar drawings (SVG, PNG, JPEG, ...); style.toml is written there.
+    #[arg(value_name = "DIR")]
+    dir: PathBuf,
+    /// Finest exemplar resolution in px (64..=1024; default 256).
+    #[arg(long, value_name = "PX")]
+    resolution: Option<u32>,
+    /// Replace an existing style.toml.
+    #[arg(long)]
+    force: bool,
 }
 
 #[derive(Args)]
@@ -384,6 +400,9 @@ fn run(cli: Cli) -> Result<(), Failure> {
         Command::Style(StyleArgs {
             command: StyleCommand::List(args),
         }) => run_style_list(args),
+        Command::Style(StyleArgs {
+            command: StyleCommand::Init(args),
+        }) => run_style_init(args, cli.quiet),
     }
 }
 
@@ -1014,6 +1033,38 @@ fn run_diff(args: DiffArgs, quiet: bool) -> Result<(), Failure> {
     }
     if report.fraction() > args.tolerance {
         return Err(Failure::Differ);
+    }
+    Ok(())
+}
+
+fn run_style_init(args: StyleInitArgs, quiet: bool) -> Result<(), Failure> {
+    let toml = args.dir.join("style.toml");
+    if toml.exists() && !args.force {
+        return Err(Failure::Usage(format!(
+            "{} exists; --force replaces it",
+            toml.display()
+        )));
+    }
+    let report = flourish::init_style(&args.dir, args.resolution)?;
+    io::write_atomic(&toml, report.to_toml().as_bytes())?;
+    for why in &report.skipped {
+        eprintln!("flourish: passed over {why}");
+    }
+    for e in report.exemplars.iter().filter(|e| e.fallback) {
+        eprintln!(
+            "flourish: {}: no clear main branch (a dot or a ring?): its ends run across its longer side; move them in {}",
+            args.dir.join(&e.file).display(),
+            toml.display()
+        );
+    }
+    if !quiet {
+        println!(
+            "{}: {} exemplar{}, ends found automatically; check them with `flourish style check {} --sheet sheet.png`",
+            toml.display(),
+            report.exemplars.len(),
+            if report.exemplars.len() == 1 { "" } else { "s" },
+            args.dir.display()
+        );
     }
     Ok(())
 }

@@ -1885,16 +1885,15 @@ fn data_style_reads_only_the_styles_folder() {
 
 #[test]
 fn brush_thin_diagonal_stroke_is_refused_at_the_canvas_limit() {
-    // One stroke 1.45 units wide across a 200-unit sketch: a 7900×7900 px
-    // canvas (under the general 64 Mpx limit) on which the synthesis
-    // would take over 7 GB and abort ("memory allocation failed", exit
-    // 134).
+    // One stroke 0.4 units wide across a 200-unit sketch: a 7000×7000 px
+    // synthesis canvas (under the general 64 Mpx limit) that would hold
+    // gigabytes; refused before anything is allocated.
     let t = tempdir();
     let a = write(
         t.path(),
         "diagonal.svg",
         r##"<svg xmlns="http://www.w3.org/2000/svg" width="200" height="200">
-<path d="M2 2 L198 198" fill="none" stroke="#000" stroke-width="1.45"/></svg>"##,
+<path d="M2 2 L198 198" fill="none" stroke="#000" stroke-width="0.4"/></svg>"##,
     );
     let out = t.path().join("out.svg");
     let cache = std::env::temp_dir().join("flourish-test-cache");

@@ -206,3 +206,73 @@ fn sheet_over_a_file_of_the_style_is_refused() {
         assert_eq!(std::fs::read(&target).unwrap(), before, "{name} changed");
     }
 }
+
+/// `style init` makes a folder of drawings a library: start and end found
+/// for each (at the tips of the fixture's drawings), a
+/// dot warned about with a usable fallback, the result passing `style
+/// check`; an existing style.toml is kept unless `--force`.
+#[test]
+fn style_init_writes_a_library_with_found_ends() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("lib");
+    small_style(&dir, TOML);
+    std::fs::remove_file(dir.join("style.toml")).unwrap();
+    std::fs::write(
+        dir.join("dot.svg"),
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="100" height="100"><circle cx="50" cy="50" r="30"/></svg>"#,
+    )
+    .unwrap();
+    std::fs::write(dir.join("notes.txt"), "not a drawing").unwrap();
+    let out = flourish(&["style", "init", s(&dir)]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("dot.svg") && err.contains("no clear main branch"),
+        "{err}"
+    );
+    let toml = std::fs::read_to_string(dir.join("style.toml")).unwrap();
+    assert_eq!(toml.matches("[[exemplar]]").count(), 3, "{toml}");
+    assert_eq!(toml.matches("start = [").count(), 3, "{toml}");
+    // The fixture's drawings run from the butt end of a wavy line at
+    // (20, 50) to the far side of a disc of radius 10 at (176, 50): the
+    // found ends of a.svg lie within 2 units (about 1 % of the spine) of
+    // those tips.
+    let found: toml::Table = toml::from_str(&toml).unwrap();
+    let ends = |file: &str| -> Option<[[f64; 2]; 2]> {
+        let e = found["exemplar"]
+            .as_array()?
+            .iter()
+            .find(|e| e["file"].as_str() == Some(file))?;
+        let p = |key: &str| -> Option<[f64; 2]> {
+            let v = e.get(key)?.as_array()?;
+            Some([v[0].as_float()?, v[1].as_float()?])
+        };
+        Some([p("start")?, p("end")?])
+    };
+    // b.svg's line meets the disc from below and starts steeply: its end
+    // is on the disc's rim where the line's direction leaves it, its
+    // start on the slanted butt end (4.5 units either side of (20, 50)).
+    let d = |p: [f64; 2], q: [f64; 2]| (p[0] - q[0]).hypot(p[1] - q[1]);
+    let [a, b] = ends("a.svg").unwrap_or_else(|| panic!("a.svg: no ends in {toml}"));
+    assert!(
+        d(a, [20.0, 50.0]) <= 2.0 && d(b, [186.0, 50.0]) <= 2.0,
+        "a.svg: found {a:?} {b:?}"
+    );
+    let [a, b] = ends("b.svg").unwrap_or_else(|| panic!("b.svg: no ends in {toml}"));
+    assert!(
+        d(a, [20.0, 50.0]) <= 4.6 && (d(b, [176.0, 50.0]) - 10.0).abs() <= 1.0 && b[0] > 176.0,
+        "b.svg: found {a:?} {b:?}"
+    );
+    let cache = tmp.path().join("cache");
+    let check = flourish(&["style", "check", s(&dir), "--cache", s(&cache)]);
+    assert_eq!(
+        check.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&check.stderr)
+    );
+    let again = flourish(&["style", "init", s(&dir)]);
+    assert_eq!(again.status.code(), Some(2));
+    let force = flourish(&["style", "init", s(&dir), "--force"]);
+    assert_eq!(force.status.code(), Some(0));
+}

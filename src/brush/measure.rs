@@ -4,22 +4,25 @@
 //! loops per stroke width), against the exemplars' own figures
 //! (decobrush.txt §7 judges by eye what these count).
 
+use super::analysis::facts::components;
 use super::analysis::BrushStyle;
-use super::output::{components, final_layers, smallest_exemplar_component};
+use super::output::final_layers;
 use super::pipeline::QueryResult;
 use crate::raster::Grid;
 use kurbo::Point;
 
-/// Ink pixels of a query's final layers (the traced SDFs).
+/// Ink pixels of a query's final layers (the traced SDFs), on its output
+/// grid.
 pub(crate) fn ink(style: &BrushStyle, r: &QueryResult) -> Grid<bool> {
     let layers = final_layers(style, r);
-    let (w, h) = (r.canvas.width, r.canvas.height);
+    let out = r.out_canvas();
+    let (w, h) = (out.width, out.height);
     Grid::from_fn(w, h, |x, y| layers.iter().any(|(_, g)| g.get(x, y) < 0.0))
 }
 
-/// Sketch position of a canvas pixel centre.
+/// Sketch position of an output pixel centre.
 pub(crate) fn at(r: &QueryResult, x: usize, y: usize) -> Point {
-    r.canvas.to_user() * Point::new(x as f64 + 0.5, y as f64 + 0.5)
+    r.out_canvas().to_user() * Point::new(x as f64 + 0.5, y as f64 + 0.5)
 }
 
 /// Distance to paper of every ink pixel, px, by a two-pass chamfer
@@ -183,6 +186,7 @@ pub(crate) struct Fidelity {
     pub(crate) farthest: f64,
     /// The smallest ink piece, px.
     pub(crate) smallest: usize,
+
     /// The largest ink piece (the body), px.
     pub(crate) largest: usize,
     /// Ink pixels on the canvas's outermost ring.
@@ -232,8 +236,7 @@ impl Fidelity {
     }
 
     /// Coverage ≥ 95 %, nothing beyond 1.5 widths, no piece smaller than
-    /// the exemplars' smallest drawn element `min` (but a short query's
-    /// body), nothing on the canvas's edge.
+    /// `min` px (but a short query's body), nothing on the canvas's edge.
     pub(crate) fn holds(&self, min: usize) -> bool {
         self.coverage >= 0.95
             && self.farthest <= 1.5
@@ -253,7 +256,8 @@ pub(crate) struct ExemplarFigures {
     pub(crate) hole: usize,
     /// The mean structure density per exemplar width.
     pub(crate) density: f64,
-    /// The smallest drawn element, px ([`smallest_exemplar_component`]).
+    /// The smallest drawn element, finest px²
+    /// ([`crate::brush::analysis::facts::StyleFacts::smallest_piece`]).
     pub(crate) smallest: usize,
 }
 
@@ -263,7 +267,7 @@ impl ExemplarFigures {
     /// query's stroke width to), so exemplars and outputs are counted per
     /// the same length of ornament.
     pub(crate) fn of(style: &BrushStyle) -> ExemplarFigures {
-        let ew = crate::brush::pipeline::exemplar_width(style).unwrap_or(1.0);
+        let ew = style.facts.width.max(1.0);
         let masks: Vec<(Grid<bool>, f64)> = style
             .exemplars
             .iter()
@@ -282,19 +286,24 @@ impl ExemplarFigures {
             spur,
             hole,
             density,
-            smallest: smallest_exemplar_component(style),
+            smallest: style.facts.smallest_piece,
         }
     }
 
-    /// The structure density per width of query `r`'s ink `mask`.
-    pub(crate) fn density_of(&self, r: &QueryResult, mask: &Grid<bool>) -> f64 {
-        let ppu = r.canvas.px_per_unit;
-        structure(mask, self.spur, self.hole).density(r.spine.width * ppu, r.spine.length * ppu)
+    /// The structure density per width of query `r`'s ink `mask` (on its
+    /// output grid, `k` output px per finest px: the pruned spur and the
+    /// smallest loop are scaled to it).
+    pub(crate) fn density_of(&self, r: &QueryResult, mask: &Grid<bool>, k: f64) -> f64 {
+        let ppu = r.out_canvas().px_per_unit;
+        let spur = (self.spur as f64 * k).round().max(1.0) as usize;
+        let hole = (self.hole as f64 * k * k).round().max(1.0) as usize;
+        structure(mask, spur, hole).density(r.spine.width * ppu, r.spine.length * ppu)
     }
 
-    /// The earth mover's distance of `mask`'s line thicknesses to the
-    /// exemplars', px.
-    pub(crate) fn thickness_distance(&self, mask: &Grid<bool>) -> f64 {
-        emd(&thicknesses(mask), &self.thicknesses)
+    /// The earth mover's distance of `mask`'s line thicknesses (an output
+    /// grid of `k` px per finest px) to the exemplars', finest px.
+    pub(crate) fn thickness_distance(&self, mask: &Grid<bool>, k: f64) -> f64 {
+        let own: Vec<f64> = thicknesses(mask).iter().map(|t| t / k).collect();
+        emd(&own, &self.thicknesses)
     }
 }

@@ -131,6 +131,22 @@ pub fn run(style: &BrushStyle, sketch: &Sketch, opts: &BrushOptions) -> Result<O
     opts.validate()?;
     let out = output::brush_sketch(style, sketch, &opts.settings())?;
     let mut notes = out.notes;
+    // Exemplars whose spine had to be guessed: said before the sketch's
+    // own warnings.
+    let mut warnings: Vec<String> = style
+        .exemplars
+        .iter()
+        .filter(|e| e.spine_source == analysis::SpineSource::Fallback)
+        .map(|e| {
+            format!(
+                "style {}: {}: {}",
+                style.name,
+                e.file.display(),
+                analysis::check::FALLBACK_WARNING
+            )
+        })
+        .collect();
+    warnings.extend(out.warnings);
     if opts.measure {
         for (i, q) in out.queries.iter().enumerate() {
             notes.push(format!(
@@ -146,7 +162,7 @@ pub fn run(style: &BrushStyle, sketch: &Sketch, opts: &BrushOptions) -> Result<O
     }
     Ok(Output {
         document: out.document,
-        warnings: out.warnings,
+        warnings,
         notes,
     })
 }

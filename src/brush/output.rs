@@ -1,11 +1,14 @@
 //! Output of the brush pipeline (decobrush.txt §6–7, SPEC "Output SVG"):
-//! each exemplar layer's SDF read through the synthesized coordinates onto
-//! the query's canvas, traced to Béziers, one `<g>` per query in drawing
-//! order with the layers' colours, bottom layer first.
+//! each exemplar layer's SDF read from the finest exemplar level through
+//! the synthesized coordinates, continued smoothly between canvas pixels,
+//! onto the query's output grid ([`super::pipeline::output_subdivision`]),
+//! traced to Béziers, one `<g>` per query in drawing order with the
+//! layers' colours, bottom layer first.
 
-use super::pipeline::{as_branch, brush_query, starts_on, QueryResult, Settings};
+use super::pipeline::{as_branch, brush_query, starts_on, to_finest, QueryResult, Settings};
 use super::query::{self, QuerySpine};
 use super::synth::{self, Coord, Field};
+use crate::brush::analysis::facts::components;
 use crate::brush::analysis::BrushStyle;
 use crate::error::{Error, Result};
 use crate::raster::{Grid, Sdf};
@@ -30,38 +33,28 @@ pub struct BrushOutput {
     pub notes: Vec<String>,
 }
 
-/// The distinct layer colours of a style, in order of first appearance
-/// (exemplar order, then each exemplar's layers bottom first).
-pub fn palette(style: &BrushStyle) -> Vec<Color> {
-    let mut out: Vec<Color> = Vec::new();
-    for e in &style.exemplars {
-        if let Some(lv) = e.finest() {
-            for l in &lv.ink.layers {
-                if !out.contains(&l.color) {
-                    out.push(l.color);
-                }
-            }
-        }
-    }
-    out
-}
-
-/// Rings (finest px) by which the coordinate field is continued beyond the
-/// region the matched segments cover before it is read: one coarsest
-/// pixel. The covered region is rasterized at the start level and
-/// upsampled by whole parents, so its edge is a staircase of coarse pixels;
-/// where an exemplar's ink reaches its rib outline the region edge would
-/// clip it along that staircase (a saw-tooth on every stem).
+/// Rings (canvas px) by which the coordinate field is continued beyond
+/// the region the matched segments cover before it is read: two
+/// start-level pixels and two more. The covered region is rasterized at
+/// the start level and upsampled by whole parents, so its edge is a
+/// staircase of coarse pixels; where an exemplar's ink reaches its rib
+/// outline (a spike's tip, a curl's end) the region edge would clip it
+/// along that staircase, in square steps.
 pub fn border_rings(r: &QueryResult) -> usize {
-    r.canvas.factor.max(1)
+    2 * r.canvas.factor.max(1) + 2
 }
 
-/// The field continued `rings` pixels beyond its covered region: ring by
-/// ring, an uncovered pixel with covered 8-neighbours takes the
+/// [`extend_owned`] on a copy of `field`.
+#[cfg(test)]
+pub fn extend_field(style: &BrushStyle, field: &Field, rings: usize) -> Field {
+    extend_owned(style, field.clone(), rings)
+}
+
+/// The field `f` continued `rings` pixels beyond its covered region: ring
+/// by ring, an uncovered pixel with covered 8-neighbours takes the
 /// continuation `μ(q) + J(q)(p − q)` of the first of them in scan order
 /// whose exemplar is the most common among them ([`synth::jacobian`]).
-pub fn extend_field(style: &BrushStyle, field: &Field, rings: usize) -> Field {
-    let mut f = field.clone();
+fn extend_owned(style: &BrushStyle, mut f: Field, rings: usize) -> Field {
     let (w, h) = (f.coords.width(), f.coords.height());
     // Only pixels next to the covered region can be reached: each ring
     // scans the covered pixels' box grown by one pixel (a tiny stroke's
@@ -159,11 +152,6 @@ fn covered_box(coords: &Grid<Option<Coord>>) -> Option<[usize; 4]> {
     bx
 }
 
-/// Radius of the blended read, px.
-const BLEND: isize = 2;
-/// Binomial weights of the blended read.
-const BINOMIAL: [f32; 5] = [1.0, 4.0, 6.0, 4.0, 1.0];
-
 /// The 8-neighbour offsets in scan order.
 const NEIGHBOURS: [(isize, isize); 8] = [
     (-1, -1),
@@ -176,220 +164,286 @@ const NEIGHBOURS: [(isize, isize); 8] = [
     (1, 1),
 ];
 
-/// The Jacobian of every pixel of a field ([`synth::jacobian`]), row-major.
-fn jacobians(style: &BrushStyle, field: &Field) -> Vec<Option<synth::Jacobian>> {
-    let (w, h) = (field.coords.width(), field.coords.height());
-    (0..h)
-        .into_par_iter()
-        .flat_map_iter(|y| (0..w).map(move |x| synth::jacobian(style, field, x, y)))
+/// The Jacobians of a field's covered pixels ([`synth::jacobian`]), held
+/// compactly: per pixel an index into the list of Jacobians
+/// ([`NO_JACOBIAN`] for none), so a thin stroke across a large canvas does
+/// not hold a Jacobian per canvas pixel.
+struct Jacobians {
+    width: usize,
+    index: Vec<u32>,
+    list: Vec<synth::Jacobian>,
+}
+
+/// The index of a pixel without a Jacobian.
+const NO_JACOBIAN: u32 = u32::MAX;
+
+impl Jacobians {
+    /// Measures every covered pixel's Jacobian.
+    fn of(style: &BrushStyle, field: &Field) -> Jacobians {
+        let (w, h) = (field.coords.width(), field.coords.height());
+        let rows: Vec<Vec<(usize, synth::Jacobian)>> = (0..h)
+            .into_par_iter()
+            .map(|y| {
+                (0..w)
+                    .filter_map(|x| synth::jacobian(style, field, x, y).map(|j| (x, j)))
+                    .collect()
+            })
+            .collect();
+        let mut index = vec![NO_JACOBIAN; w * h];
+        let mut list = Vec::with_capacity(rows.iter().map(Vec::len).sum());
+        for (y, row) in rows.into_iter().enumerate() {
+            for (x, j) in row {
+                index[y * w + x] = list.len().min(NO_JACOBIAN as usize - 1) as u32;
+                list.push(j);
+            }
+        }
+        Jacobians {
+            width: w,
+            index,
+            list,
+        }
+    }
+
+    /// The Jacobian of pixel `(x, y)`, if measured.
+    fn get(&self, x: isize, y: isize) -> Option<synth::Jacobian> {
+        if x < 0 || y < 0 || x as usize >= self.width {
+            return None;
+        }
+        let i = *self.index.get(y as usize * self.width + x as usize)?;
+        self.list.get(i as usize).copied()
+    }
+}
+
+/// An output pixel beyond this many output px of all ink has every layer
+/// written as the all-ink distance (a lower bound, and paper): no contour
+/// runs through such a pixel's cells, and its layers need no reading.
+const FAR: f32 = 4.0;
+
+/// Where one exemplar's layers are read: its top level's scale to the
+/// finest, and its finest all-ink SDF and SDF of each palette colour.
+struct Source<'a> {
+    to_fine: f32,
+    ink: &'a Grid<f32>,
+    layers: Vec<Option<&'a Grid<f32>>>,
+}
+
+/// The layers' SDFs (in the order of the style's palette, output px) read
+/// through a synthesized (already extended) field onto the output grid,
+/// the canvas subdivided `sub` times; `PAPER` off the ornament.
+///
+/// Every canvas pixel `q` continues its coordinate to any point `p` of the
+/// plane, `μ(q) + J(q)(p − q)` (its patch carried on by its Jacobian,
+/// [`synth::jacobian`]); an output pixel's centre `p` takes the exemplar
+/// distances at the continuations of the four canvas pixels around it
+/// (bilinear in the finest exemplar level), averaged with the bilinear
+/// weights of `p` between their centres. Inside a coherent patch every
+/// continuation is the same point and the read is the exemplar's own
+/// outline at continuous coordinates, whatever the canvas resolution (no
+/// pixel staircase); across a seam the two patches are cross-faded over a
+/// canvas pixel, so outlines cross it without steps, and a lone pixel whose
+/// μ landed on another layer's ink is outvoted (the output reading of
+/// decobrush.txt §5.4: colours are read through μ, §7). A neighbour whose
+/// exemplar lacks a colour gives paper for it. The field's Jacobians are
+/// measured beforehand (`jac`).
+fn read_layers(style: &BrushStyle, field: &Field, jac: &Jacobians, sub: usize) -> Vec<Grid<f32>> {
+    let palette = &style.facts.palette;
+    let g = &field.coords;
+    let (w, h) = (g.width(), g.height());
+    let k = sub.max(1);
+    let (ow, oh) = (w * k, h * k);
+    let sources: Vec<Option<Source>> = style
+        .exemplars
+        .iter()
+        .map(|e| {
+            let fine = e.finest()?;
+            let lv = e.levels.get(field.level)?;
+            Some(Source {
+                to_fine: (1.0 / lv.scale) as f32,
+                ink: &fine.ink.ink,
+                layers: palette
+                    .iter()
+                    .map(|c| {
+                        fine.ink
+                            .layers
+                            .iter()
+                            .find(|l| l.color == *c)
+                            .map(|l| &l.sdf)
+                    })
+                    .collect(),
+            })
+        })
+        .collect();
+    // Output px per finest exemplar px (the exemplars share their scales).
+    let to_out = sources
+        .iter()
+        .flatten()
+        .next()
+        .map_or(1.0, |s| k as f32 / s.to_fine);
+    let paper = PAPER * to_out;
+    let n = palette.len();
+    let src = |e: usize| sources.get(e).and_then(Option::as_ref);
+    // The covered columns of each canvas row, `[lo, hi)`: an output row
+    // reads only the span of the two canvas rows around it.
+    let spans: Vec<(usize, usize)> = (0..h)
+        .map(|y| {
+            let row = &g.data()[y * w..(y + 1) * w];
+            match (
+                row.iter().position(Option::is_some),
+                row.iter().rposition(Option::is_some),
+            ) {
+                (Some(a), Some(b)) => (a, b + 1),
+                _ => (w, 0),
+            }
+        })
+        .collect();
+    let mut grids: Vec<Vec<f32>> = (0..n).map(|_| vec![paper; ow * oh]).collect();
+    // Row `oy` of every layer, to be written by one task.
+    let mut rows: Vec<Vec<&mut [f32]>> = (0..oh).map(|_| Vec::with_capacity(n)).collect();
+    for grid in &mut grids {
+        for (row, chunk) in rows.iter_mut().zip(grid.chunks_mut(ow.max(1))) {
+            row.push(chunk);
+        }
+    }
+    rows.into_par_iter().enumerate().for_each(|(oy, mut out)| {
+        let py = (oy as f32 + 0.5) / k as f32 - 0.5;
+        let j0 = py.floor();
+        let fy = py - j0;
+        let j0 = j0 as isize;
+        let span = |j: isize| {
+            usize::try_from(j)
+                .ok()
+                .and_then(|j| spans.get(j).copied())
+                .unwrap_or((w, 0))
+        };
+        let (a, b) = (span(j0), span(j0 + 1));
+        let (lo, hi) = (a.0.min(b.0), a.1.max(b.1));
+        if lo >= hi {
+            return;
+        }
+        // Output columns whose four canvas pixels may reach the span.
+        let (x0, x1) = ((lo * k).saturating_sub(k), ((hi + 1) * k).min(ow));
+        // Continuations: exemplar, finest position, weight.
+        let mut taps: Vec<(usize, f32, f32, f32)> = Vec::with_capacity(4);
+        for ox in x0..x1 {
+            let px = (ox as f32 + 0.5) / k as f32 - 0.5;
+            let i0 = px.floor();
+            let fx = px - i0;
+            let i0 = i0 as isize;
+            taps.clear();
+            for (di, dj, wt) in [
+                (0isize, 0isize, (1.0 - fx) * (1.0 - fy)),
+                (1, 0, fx * (1.0 - fy)),
+                (0, 1, (1.0 - fx) * fy),
+                (1, 1, fx * fy),
+            ] {
+                if wt <= 0.0 {
+                    continue;
+                }
+                let (i, j) = (i0 + di, j0 + dj);
+                let Some(c) = g.get_or(i, j, None) else {
+                    continue;
+                };
+                let Some(jm) = jac.get(i, j) else {
+                    continue;
+                };
+                let Some(s) = src(c.exemplar as usize) else {
+                    continue;
+                };
+                let d = synth::apply(jm, [fx - di as f32, fy - dj as f32]);
+                taps.push((
+                    c.exemplar as usize,
+                    (c.x + d[0]) * s.to_fine,
+                    (c.y + d[1]) * s.to_fine,
+                    wt,
+                ));
+            }
+            if taps.is_empty() {
+                continue;
+            }
+            let wsum: f32 = taps.iter().map(|t| t.3).sum();
+            // Layer `l`, or all ink for `None`.
+            let read = |l: Option<usize>| -> f32 {
+                taps.iter()
+                    .map(|&(e, x, y, wt)| {
+                        wt * src(e)
+                            .and_then(|s| match l {
+                                None => Some(s.ink),
+                                Some(l) => s.layers.get(l).copied().flatten(),
+                            })
+                            .map_or(PAPER, |g| g.sample(x as f64, y as f64))
+                    })
+                    .sum::<f32>()
+                    / wsum
+                    * to_out
+            };
+            let ink = read(None);
+            if ink >= FAR {
+                for row in out.iter_mut() {
+                    row[ox] = ink;
+                }
+                continue;
+            }
+            for (l, row) in out.iter_mut().enumerate() {
+                row[ox] = read(Some(l));
+            }
+        }
+    });
+    grids
+        .into_iter()
+        .map(|data| Grid::from_vec(ow, oh, data).unwrap_or_else(|| Grid::new(ow, oh, paper)))
         .collect()
 }
 
-/// The SDF of the layer of colour `color` (`None`: all ink) read through
-/// a synthesized (already extended) field, px; `PAPER` off the ornament.
-/// Each pixel `p` blends the predictions of its 3×3 neighbourhood:
-/// neighbour `q` predicts the coordinate `μ(q) + J(q)(p − q)` (its patch
-/// continued to `p`, [`synth::jacobian`]) and gives the exemplar's SDF
-/// there (bilinear); the values are averaged with binomial weights 1-2-1
-/// (a neighbour whose exemplar lacks the colour gives paper). Inside a
-/// coherent patch every prediction is `μ(p)` itself and the read is
-/// exact; across a seam the two patches' fields are cross-faded over
-/// three pixels, so outlines cross seams without steps or spurs, and a
-/// lone pixel whose μ landed on another layer's ink (a speck) is outvoted
-/// by its neighbours (the output reading of decobrush.txt §5.4: colours
-/// are read through μ, §7). The field's Jacobians are measured beforehand
-/// (`jac`, from [`jacobians`]): the layers of one query share them.
-fn blended_sdf_with(
-    style: &BrushStyle,
-    field: &Field,
-    jac: &[Option<synth::Jacobian>],
-    color: Option<Color>,
-) -> Grid<f32> {
-    let g = &field.coords;
-    let (w, h) = (g.width(), g.height());
-    let level = field.level;
-    let read = |c: Coord| -> f32 {
-        style
-            .exemplars
-            .get(c.exemplar as usize)
-            .and_then(|e| e.levels.get(level))
-            .and_then(|lv| match color {
-                None => Some(&lv.ink.ink),
-                Some(col) => lv
-                    .ink
-                    .layers
-                    .iter()
-                    .find(|l| l.color == col)
-                    .map(|l| &l.sdf),
-            })
-            .map(|grid| grid.sample(c.x as f64, c.y as f64))
-            .unwrap_or(PAPER)
-    };
-    let rows: Vec<Vec<f32>> = (0..h)
-        .into_par_iter()
-        .map(|y| {
-            (0..w)
-                .map(|x| {
-                    if g.get(x, y).is_none() {
-                        return PAPER;
-                    }
-                    let (mut acc, mut wsum) = (0.0f32, 0.0f32);
-                    for dy in -BLEND..=BLEND {
-                        for dx in -BLEND..=BLEND {
-                            let (nx, ny) = (x as isize + dx, y as isize + dy);
-                            let Some(c) = g.get_or(nx, ny, None) else {
-                                continue;
-                            };
-                            let Some(j) = jac.get(ny as usize * w + nx as usize).copied().flatten()
-                            else {
-                                continue;
-                            };
-                            let d = synth::apply(j, [-dx as f32, -dy as f32]);
-                            let wt =
-                                BINOMIAL[(dx + BLEND) as usize] * BINOMIAL[(dy + BLEND) as usize];
-                            let p = Coord {
-                                exemplar: c.exemplar,
-                                x: c.x + d[0],
-                                y: c.y + d[1],
-                            };
-                            acc += wt * read(p);
-                            wsum += wt;
-                        }
-                    }
-                    if wsum > 0.0 {
-                        acc / wsum
-                    } else {
-                        PAPER
-                    }
-                })
-                .collect()
-        })
-        .collect();
-    Grid::from_vec(w, h, rows.concat()).unwrap_or_else(|| Grid::new(w, h, PAPER))
-}
-
-/// The 4-connected components of a mask, as lists of pixel indices
-/// (row-major), in scan order.
-pub fn components(mask: &Grid<bool>) -> Vec<Vec<usize>> {
-    let (w, h) = (mask.width(), mask.height());
-    let mut seen = vec![false; w * h];
-    let mut out = Vec::new();
-    for start in 0..w * h {
-        if seen[start] || !mask.data()[start] {
-            continue;
-        }
-        seen[start] = true;
-        let mut comp = vec![start];
-        let mut k = 0;
-        while let Some(&i) = comp.get(k) {
-            k += 1;
-            let (x, y) = (i % w, i / w);
-            let mut visit = |j: usize| {
-                if !seen[j] && mask.data()[j] {
-                    seen[j] = true;
-                    comp.push(j);
-                }
-            };
-            if x > 0 {
-                visit(i - 1);
-            }
-            if x + 1 < w {
-                visit(i + 1);
-            }
-            if y > 0 {
-                visit(i - w);
-            }
-            if y + 1 < h {
-                visit(i + w);
-            }
-        }
-        out.push(comp);
-    }
-    out
-}
-
-/// Smallest ink component counted as a drawn element, px² (the tracer's
-/// default `min_area`: smaller ones are rasterization specks).
-pub const SPECK: usize = 4;
-
-/// How deep (px) inside its outline some pixel of a drawn element lies: a
-/// piece with no pixel centre a pixel from its edge is under 2 px thick
-/// everywhere, a fragment of a hairline tip broken up by rasterization
-/// (the scroll's tapering spikes leave 1–4 px dots at 512 px), not
-/// something the artist drew.
-pub const ELEMENT_DEPTH: f32 = 1.0;
-
-/// The area (finest px²) of the smallest drawn element of any exemplar of
-/// the style: a component of its ink of at least [`SPECK`] px² that is at
-/// least [`ELEMENT_DEPTH`] deep somewhere. Ornament pieces smaller than
-/// this are synthesis debris.
-pub fn smallest_exemplar_component(style: &BrushStyle) -> usize {
-    style
-        .exemplars
-        .iter()
-        .filter_map(|e| e.finest())
-        .flat_map(|lv| {
-            let sdf = &lv.ink.ink;
-            components(&sdf.map(|d| d < 0.0))
-                .into_iter()
-                .filter(|c| {
-                    c.iter()
-                        .any(|&i| sdf.data().get(i).is_some_and(|&d| d <= -ELEMENT_DEPTH))
-                })
-                .map(|c| c.len())
-        })
-        .filter(|&n| n >= SPECK)
-        .min()
-        .unwrap_or(SPECK)
-}
-
-/// [`final_layers_with`], measuring the style's facts first.
+/// The final per-layer SDFs of a query on its output grid (see
+/// [`final_layers_with`]).
 #[cfg(test)]
 pub fn final_layers(style: &BrushStyle, r: &QueryResult) -> Vec<(Color, Grid<f32>)> {
-    final_layers_with(style, r, &StyleFacts::of(style))
+    final_layers_with(style, r, r.field.clone())
 }
 
-/// What the output stage needs to know about a style, measured once per
-/// sketch instead of once per query: the smallest drawn element scans
-/// every exemplar's finest ink, a large share of a short stroke's cost.
-#[derive(Clone, Debug)]
-struct StyleFacts {
-    /// The layer colours ([`palette`]).
-    palette: Vec<Color>,
-    /// [`smallest_exemplar_component`].
-    smallest_piece: usize,
+/// Output px per finest exemplar px of a query's output grid.
+pub fn out_per_fine(style: &BrushStyle, r: &QueryResult) -> f64 {
+    let s = style
+        .exemplars
+        .first()
+        .and_then(|e| e.levels.get(r.field.level))
+        .map_or(1.0, |lv| lv.scale);
+    r.sub.max(1) as f64 * s
 }
 
-impl StyleFacts {
-    fn of(style: &BrushStyle) -> StyleFacts {
-        StyleFacts {
-            palette: palette(style),
-            smallest_piece: smallest_exemplar_component(style),
-        }
-    }
+/// Largest debris, as a share of a stroke width: a piece under a square
+/// this many widths on a side is a speck beside the stroke, whatever the
+/// exemplars' pieces measure. In a library of single-piece exemplars (a
+/// hairline lattice, a scroll) the smallest drawn element is a whole
+/// exemplar, larger than a stroke width squared, and a seam that leaves a
+/// stretch of line apart leaves a piece smaller than that: by the
+/// exemplars' pieces alone, whole stretches of the stroke would be
+/// cleared.
+pub const DEBRIS_WIDTH: f64 = 0.5;
+
+/// The area under which an output piece is debris, finest px²: the
+/// exemplars' smallest drawn element
+/// ([`crate::brush::analysis::facts::StyleFacts::smallest_piece`]), at
+/// most a square of [`DEBRIS_WIDTH`] exemplar widths.
+pub fn debris_area(style: &BrushStyle) -> f64 {
+    let side = DEBRIS_WIDTH * style.facts.width;
+    (style.facts.smallest_piece as f64).min(side * side)
 }
 
-/// The final per-layer canvas SDFs of a query, bottom layer first, with
-/// their colours: each layer read through the continued field with the
-/// blended read ([`blended_sdf_with`]); then a last, documented cleanup: ink
-/// components smaller than the exemplars' smallest piece
-/// ([`smallest_exemplar_component`], the threshold taken from the style,
-/// not a constant) are synthesis debris and are cleared; the query's
-/// largest piece is its body and always stays. The style's facts
-/// (`facts`) are measured once per sketch.
-fn final_layers_with(
-    style: &BrushStyle,
-    r: &QueryResult,
-    facts: &StyleFacts,
-) -> Vec<(Color, Grid<f32>)> {
-    let field = extend_field(style, &r.field, border_rings(r));
-    let jac = jacobians(style, &field);
-    let mut layers: Vec<(Color, Grid<f32>)> = facts
-        .palette
-        .iter()
-        .map(|&c| (c, blended_sdf_with(style, &field, &jac, Some(c))))
-        .collect();
+/// The final per-layer SDFs of a query on its output grid (output px),
+/// bottom layer first, with their colours: each layer read through the
+/// continued field ([`read_layers`]); then a last, documented cleanup: ink
+/// components smaller than [`debris_area`] (the threshold taken from the
+/// style, not a constant) are synthesis debris and are cleared; the
+/// query's largest piece is its body and always stays. `field` is the
+/// query's field (or a copy of it), used up.
+fn final_layers_with(style: &BrushStyle, r: &QueryResult, field: Field) -> Vec<(Color, Grid<f32>)> {
+    let field = extend_owned(style, field, border_rings(r));
+    let jac = Jacobians::of(style, &field);
+    let read = read_layers(style, &field, &jac, r.sub);
     drop(jac);
+    let mut layers: Vec<(Color, Grid<f32>)> =
+        style.facts.palette.iter().copied().zip(read).collect();
     let Some((_, first)) = layers.first() else {
         return layers;
     };
@@ -399,7 +453,9 @@ fn final_layers_with(
     // A query shorter than every exemplar can have a body smaller than
     // the exemplars' smallest piece: the largest piece always stays.
     let largest = comps.iter().map(Vec::len).max().unwrap_or(0);
-    let min = facts.smallest_piece.min(largest);
+    let scale = out_per_fine(style, r);
+    let smallest = (debris_area(style) * scale * scale).round() as usize;
+    let min = smallest.min(largest);
     for comp in comps {
         if comp.len() >= min {
             continue;
@@ -415,24 +471,23 @@ fn final_layers_with(
     layers
 }
 
-/// [`trace_query_with`], measuring the style's facts first.
-#[cfg(test)]
+/// Traces a synthesized query into one group of filled shapes, bottom
+/// layer first.
 pub fn trace_query(style: &BrushStyle, r: &QueryResult, id: String, opts: &TraceOptions) -> Group {
-    trace_query_with(style, r, id, opts, &StyleFacts::of(style))
+    trace_field(style, r, r.field.clone(), id, opts)
 }
 
-/// Traces a synthesized query into one group of filled shapes, bottom
-/// layer first; the style's facts (`facts`) are measured once per sketch.
-fn trace_query_with(
+/// [`trace_query`] with the query's field (or a copy of it) used up.
+fn trace_field(
     style: &BrushStyle,
     r: &QueryResult,
+    field: Field,
     id: String,
     opts: &TraceOptions,
-    facts: &StyleFacts,
 ) -> Group {
-    let to_user = r.canvas.to_user();
+    let to_user = r.out_canvas().to_user();
     let mut shapes = Vec::new();
-    for (color, dist) in final_layers_with(style, r, facts) {
+    for (color, dist) in final_layers_with(style, r, field) {
         let sdf = Sdf { dist, to_user };
         for p in trace_sdf(&sdf, opts) {
             shapes.push(Shape {
@@ -481,7 +536,7 @@ pub fn prepared_spines(
 /// dilated by 2 px.
 fn refine_one(
     style: &BrushStyle,
-    mut r: QueryResult,
+    r: QueryResult,
     tree: &resvg::usvg::Tree,
     opts: &Settings,
 ) -> QueryResult {
@@ -489,6 +544,7 @@ fn refine_one(
         seed: opts.seed,
         ..opts.synth.clone()
     };
+    let mut r = to_finest(style, r);
     let (w, h) = (r.canvas.width, r.canvas.height);
     let Some(mut pixmap) = resvg::tiny_skia::Pixmap::new(w as u32, h as u32) else {
         return r;
@@ -552,7 +608,6 @@ pub fn brush_sketch(style: &BrushStyle, sketch: &Sketch, opts: &Settings) -> Res
     let (spines, warnings, notes) = prepared_spines(sketch, opts)?;
     let refine = opts.refine.as_ref().map(|r| &*r.tree);
     let trace = TraceOptions::default();
-    let facts = StyleFacts::of(style);
     let done: Vec<(QueryResult, Group)> = spines
         .par_iter()
         .map(|q| {
@@ -567,22 +622,25 @@ pub fn brush_sketch(style: &BrushStyle, sketch: &Sketch, opts: &Settings) -> Res
             } else {
                 r.spine.query_id.clone()
             };
-            let group = trace_query_with(style, &r, id, &trace, &facts);
-            if opts.discard_fields {
-                r.field = Field {
+            let group = if opts.discard_fields {
+                let empty = Field {
                     level: r.field.level,
                     coords: Grid::new(0, 0, None),
                     orient: Grid::new(0, 0, [0.0; 2]),
                     seam: Grid::new(0, 0, false),
                 };
+                let field = std::mem::replace(&mut r.field, empty);
                 r.levels = Vec::new();
-            }
+                trace_field(style, &r, field, id, &trace)
+            } else {
+                trace_query(style, &r, id, &trace)
+            };
             Ok((r, group))
         })
         .collect::<Result<Vec<_>>>()?;
     let ppu = done
         .iter()
-        .map(|(r, _)| r.canvas.px_per_unit)
+        .map(|(r, _)| r.out_canvas().px_per_unit)
         .fold(0.0f64, f64::max);
     let mut document = Document::new(
         sketch.width,

@@ -1,14 +1,27 @@
 //! The `flourish brush` pipeline for one sketch (decobrush.txt §5–7):
 //! query spines → piecewise matching → ARAP per segment → coordinate fields
 //! at the coarsest level → graph-cut seams in the overlaps → hierarchical
-//! synthesis over the style's three levels → per-layer SDFs on the canvas
-//! → Bézier outlines, one `<g>` per query ([`super::output`]).
+//! synthesis up to the level the output needs → per-layer SDFs read at
+//! continuous coordinates onto the output grid → Bézier outlines, one `<g>`
+//! per query ([`super::output`]).
 //!
-//! **Canvas scale.** Each query gets its own canvas around its spine whose
-//! finest pixels are the exemplars' finest pixels: `px_per_unit = W_e / W_q`
-//! with `W_e` the style's mean rib width (finest px) and `W_q` the query's
-//! stroke width (sketch units), so the ornament is as wide as the stroke.
-//! Level `l` of the canvas is the finest divided by `2^(L−1−l)`.
+//! **Scales.** A query's stroke width `W_q` (sketch units) is mapped to the
+//! style's exemplar width `W_e` (finest px), so the ornament is as wide as
+//! the stroke: the exemplars' finest level has `W_e / W_q` px per unit, and
+//! level `l` `2^(L−1−l)` times fewer. The cost follows the output, not the
+//! exemplars' resolution:
+//! - synthesis starts on the coarsest level where the stroke is at least
+//!   [`MIN_SYNTH_WIDTH`] px wide ([`start_level`]) and stops on the
+//!   coarsest where it is as wide as the output needs ([`top_level`]:
+//!   about a pixel per sketch unit, [`SYNTH_WIDTH`] px at most); the
+//!   query's [`Canvas`] is that top level;
+//! - the output grid subdivides the canvas ([`QueryResult::sub`]) until it
+//!   has [`OUT_PX_PER_UNIT`] px per sketch unit (the tracing tolerance,
+//!   0.25 px, is then an eighth of a unit) and the style's thinnest line
+//!   spans [`LINE_PX`] px ([`output_subdivision`]), never finer than the
+//!   exemplars' finest level; the layers are read there from the finest
+//!   exemplar level through the synthesized coordinates, continued
+//!   smoothly between canvas pixels.
 //!
 //! **Branching** (§7). A stroke whose start lies on an earlier stroke (within
 //! half its width of the earlier spine) grows out of it: its start is not
@@ -48,6 +61,9 @@ pub struct Settings {
     /// (0 = coarsest); `None`: the coarsest level on which the exemplar
     /// strokes are at least [`MIN_SYNTH_WIDTH`] px wide.
     pub start_level: Option<usize>,
+    /// Pyramid level at which the synthesis stops (at least the start
+    /// level); `None`: the one the output needs ([`top_level`]).
+    pub top_level: Option<usize>,
     /// A refinement sketch (§5.5, `--refine`): black strokes add ink,
     /// white ones erase it; same viewBox as the sketch.
     pub refine: Option<super::Refinement>,
@@ -60,32 +76,44 @@ pub struct Settings {
     pub discard_fields: bool,
 }
 
-/// A query's canvas: finest-level pixel `(x, y)` has its centre at sketch
-/// point `origin + (x + ½, y + ½) / px_per_unit`.
+/// A query's canvas, at the synthesis's top level: pixel `(x, y)` has its
+/// centre at sketch point `origin + (x + ½, y + ½) / px_per_unit`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Canvas {
     /// Sketch point at the canvas's top-left corner.
     pub origin: Point,
-    /// Finest-level canvas pixels per sketch unit.
+    /// Top-level canvas pixels per sketch unit.
     pub px_per_unit: f64,
-    /// Finest-level width, px.
+    /// Top-level width, px.
     pub width: usize,
-    /// Finest-level height, px.
+    /// Top-level height, px.
     pub height: usize,
-    /// Finest over coarsest pixel size (`2^(levels − 1)`).
+    /// Top-level over start-level pixel size (`2^(top − start)`).
     pub factor: usize,
 }
 
 impl Canvas {
-    /// Canvas pixel coordinates at level scale `s` (1 = finest) of a
-    /// sketch point.
+    /// Canvas pixel coordinates at level scale `s` (1 = the top level) of
+    /// a sketch point.
     pub fn to_pixel(self, s: f64) -> Affine {
         Affine::scale(self.px_per_unit * s) * Affine::translate(-self.origin.to_vec2())
     }
 
-    /// Sketch coordinates of a finest-level pixel-space point.
+    /// Sketch coordinates of a top-level pixel-space point.
     pub fn to_user(self) -> Affine {
         Affine::translate(self.origin.to_vec2()) * Affine::scale(1.0 / self.px_per_unit)
+    }
+
+    /// The same canvas with every pixel split into `sub` × `sub`.
+    pub fn subdivided(self, sub: usize) -> Canvas {
+        let k = sub.max(1);
+        Canvas {
+            origin: self.origin,
+            px_per_unit: self.px_per_unit * k as f64,
+            width: self.width * k,
+            height: self.height * k,
+            factor: self.factor * k,
+        }
     }
 }
 
@@ -94,15 +122,17 @@ impl Canvas {
 pub struct QueryResult {
     /// The query spine (after branching adjustments of its features).
     pub spine: QuerySpine,
-    /// Its canvas.
+    /// Its canvas (the synthesis's top level).
     pub canvas: Canvas,
-    /// The synthesized coordinate field at the finest level.
+    /// Output pixels per canvas pixel side ([`output_subdivision`]).
+    pub sub: usize,
+    /// The synthesized coordinate field at the top level.
     pub field: Field,
     /// Matched segments (exemplar index, query sample range); empty for the
     /// art-brush baseline.
     pub segments: Vec<(usize, std::ops::Range<usize>)>,
-    /// The corrected field of every synthesis level, coarse to fine (for
-    /// refinement, §5.5); empty for the baseline.
+    /// The corrected field of every synthesis level, coarse to fine, when
+    /// a refinement will read them (§5.5); else empty.
     pub levels: Vec<Field>,
 }
 
@@ -111,6 +141,11 @@ impl QueryResult {
     /// computed on demand, it costs about one correction pass.
     pub fn energy(&self, style: &BrushStyle) -> f64 {
         synth::energy(style, &self.field)
+    }
+
+    /// The output grid: the canvas subdivided [`Self::sub`] times.
+    pub fn out_canvas(&self) -> Canvas {
+        self.canvas.subdivided(self.sub)
     }
 }
 
@@ -123,13 +158,67 @@ pub const MIN_SYNTH_WIDTH: f64 = 8.0;
 /// The coarsest level whose mean stroke width is at least
 /// [`MIN_SYNTH_WIDTH`] px (`ew`: the mean width at the finest level).
 pub fn start_level(style: &BrushStyle, ew: f64) -> usize {
+    level_at_least(style, ew, MIN_SYNTH_WIDTH)
+}
+
+/// Widest stroke, px, the synthesis needs: its 5×5 neighbourhoods then
+/// span a fifth of the stroke, which places the ornament's pieces and
+/// joins its lines; what is finer than a pixel there (hairlines, the
+/// shapes of outlines) is read from the exemplars' finest level through
+/// the synthesized coordinates ([`super::output`]).
+pub const SYNTH_WIDTH: f64 = 24.0;
+
+/// Synthesis pixels per sketch unit a stroke needs at most: a pixel per
+/// unit, one output pixel at 100 %, under [`SYNTH_WIDTH`].
+pub const SYNTH_PX_PER_UNIT: f64 = 1.0;
+
+/// The level the synthesis stops on for a stroke `width` sketch units
+/// wide: the coarsest whose stroke is as wide as the output needs,
+/// `width` × [`SYNTH_PX_PER_UNIT`] px clamped to [`MIN_SYNTH_WIDTH`] ..=
+/// [`SYNTH_WIDTH`], or the finest when none is that wide.
+pub fn top_level(style: &BrushStyle, ew: f64, width: f64) -> usize {
+    let want = (width * SYNTH_PX_PER_UNIT).clamp(MIN_SYNTH_WIDTH, SYNTH_WIDTH);
+    level_at_least(style, ew, want)
+}
+
+/// The coarsest level on which a stroke `ew` finest px wide is at least
+/// `px` px wide, else the finest.
+fn level_at_least(style: &BrushStyle, ew: f64, px: f64) -> usize {
     let Some(e) = style.exemplars.first() else {
         return 0;
     };
     e.levels
         .iter()
-        .position(|l| ew * l.scale >= MIN_SYNTH_WIDTH)
+        .position(|l| ew * l.scale >= px)
         .unwrap_or(e.levels.len().saturating_sub(1))
+}
+
+/// Output pixels per sketch unit at least (tracing within 0.25 px is then
+/// within an eighth of a unit).
+pub const OUT_PX_PER_UNIT: f64 = 2.0;
+
+/// Output pixels the style's thinnest line must span so that the output
+/// grid's samples cannot miss it.
+pub const LINE_PX: f64 = 2.0;
+
+/// Most output pixels per canvas pixel side.
+pub const MAX_SUB: usize = 16;
+
+/// The output grid's subdivision of a canvas of `ppu` px per unit for a
+/// stroke mapped at `fine` finest exemplar px per unit: the least whole
+/// number that gives [`OUT_PX_PER_UNIT`] and [`LINE_PX`] across the
+/// style's thinnest line, the latter never beyond the finest level's own
+/// resolution, and never coarser than the canvas.
+pub fn output_subdivision(style: &BrushStyle, ppu: f64, fine: f64) -> usize {
+    let thin = style.facts.thinnest_line.max(1e-3);
+    let line = (fine * LINE_PX / thin).min(fine);
+    let want = OUT_PX_PER_UNIT.max(line);
+    let k = (want / ppu.max(1e-9) - 1e-9).ceil();
+    if k.is_finite() {
+        (k.max(1.0) as usize).min(MAX_SUB)
+    } else {
+        1
+    }
 }
 
 /// Largest canvas of one brush query, pixels in all (16 Mpx). Synthesis
@@ -140,12 +229,18 @@ pub fn start_level(style: &BrushStyle, ew: f64) -> usize {
 /// is about 1.8 GB, twenty times the largest canvas of the shipped samples.
 pub const MAX_BRUSH_PIXELS: u64 = 16 << 20;
 
+/// Largest output grid of one brush query, pixels in all (32 Mpx, about
+/// 30 bytes each: the layers' SDFs and the ink mask); a finer one is not
+/// allocated, the subdivision is lowered instead.
+pub const MAX_OUT_PIXELS: u64 = 32 << 20;
+
 /// The canvas of a query spine: its bounding box grown by 1.5 stroke
 /// widths (the farthest an ornament may reach from its spine; a smaller
 /// margin cuts end curls and outer leaves flat on the canvas border),
-/// at `W_e / W_q` finest pixels per unit, a whole number of coarsest
-/// pixels; checked against the canvas limits (and [`MAX_BRUSH_PIXELS`])
-/// before anything is allocated.
+/// at `ew / W_q` pixels per unit (`ew`: the stroke's width in pixels of
+/// the canvas's level), a whole number of `factor` pixels; checked against
+/// the canvas limits (and [`MAX_BRUSH_PIXELS`]) before anything is
+/// allocated.
 pub fn canvas_for(q: &QuerySpine, ew: f64, factor: usize) -> Result<Canvas> {
     let ppu = ew / q.width;
     let (mut x0, mut y0, mut x1, mut y1) = (f64::MAX, f64::MAX, f64::MIN, f64::MIN);
@@ -186,15 +281,9 @@ pub fn canvas_for(q: &QuerySpine, ew: f64, factor: usize) -> Result<Canvas> {
 
 /// The query orientation ω^q of a coordinate field from one warped
 /// exemplar: `ω^q ∝ J⁻¹ ω^e` with `J = ∂μ/∂p` by finite differences.
-fn orient_of(
-    style: &BrushStyle,
-    level: usize,
-    e: u32,
-    g: &Grid<Option<Point>>,
-    x: usize,
-    y: usize,
-) -> Option<[f32; 2]> {
-    let at = |dx: isize, dy: isize| g.get_or(x as isize + dx, y as isize + dy, None);
+fn orient_of(style: &BrushStyle, level: usize, g: &Patch, x: usize, y: usize) -> Option<[f32; 2]> {
+    let e = g.exemplar;
+    let at = |dx: isize, dy: isize| g.get_or(x as isize + dx, y as isize + dy);
     let c = at(0, 0)?;
     let diff =
         |a: Option<Point>, b: Option<Point>, span: f64| -> Option<Vec2> { Some((a? - b?) / span) };
@@ -231,12 +320,85 @@ fn orient_of(
 /// pixel-sized patches that break lines.
 pub const SEAM_MARGIN: isize = 2;
 
+/// One warped exemplar segment's coordinates on the canvas (exemplar
+/// px, `None` off its mesh), held only over the box its mesh covers.
+pub(crate) struct Patch {
+    /// The exemplar.
+    pub(crate) exemplar: u32,
+    /// Canvas column of the box's left side.
+    pub(crate) x0: usize,
+    /// Canvas row of the box's top side.
+    pub(crate) y0: usize,
+    /// The coordinates over the box.
+    pub(crate) grid: Grid<Option<Point>>,
+}
+
+impl Patch {
+    /// The coordinate at canvas pixel `(x, y)`.
+    fn get(&self, x: usize, y: usize) -> Option<Point> {
+        self.get_or(x as isize, y as isize)
+    }
+
+    /// The coordinate at canvas pixel `(x, y)`, `None` outside the box.
+    fn get_or(&self, x: isize, y: isize) -> Option<Point> {
+        self.grid
+            .get_or(x - self.x0 as isize, y - self.y0 as isize, None)
+    }
+
+    /// The box `[x0, y0, x1, y1)` on the canvas.
+    fn bounds(&self) -> [usize; 4] {
+        [
+            self.x0,
+            self.y0,
+            self.x0 + self.grid.width(),
+            self.y0 + self.grid.height(),
+        ]
+    }
+}
+
+/// The coordinate patch of a deformed rib mesh (`deformed`: positions in
+/// pixels of a `width` × `height` canvas): rasterized over the box of its
+/// vertices clipped to the canvas ([`rasterize_coords`]).
+fn rasterize_patch(
+    exemplar: u32,
+    mesh: &RibMesh,
+    deformed: &[Point],
+    width: usize,
+    height: usize,
+) -> Result<Patch> {
+    let (mut x0, mut y0, mut x1, mut y1) = (f64::MAX, f64::MAX, f64::MIN, f64::MIN);
+    for p in deformed {
+        (x0, y0) = (x0.min(p.x), y0.min(p.y));
+        (x1, y1) = (x1.max(p.x), y1.max(p.y));
+    }
+    let clip = |v: f64, hi: usize| {
+        if v.is_finite() {
+            v.clamp(0.0, hi as f64) as usize
+        } else {
+            0
+        }
+    };
+    let (bx0, by0) = (clip(x0.floor(), width), clip(y0.floor(), height));
+    let (bx1, by1) = (clip(x1.ceil() + 1.0, width), clip(y1.ceil() + 1.0, height));
+    let (bw, bh) = (
+        bx1.saturating_sub(bx0).max(1),
+        by1.saturating_sub(by0).max(1),
+    );
+    let shift = Affine::translate((-(bx0 as f64), -(by0 as f64)));
+    Ok(Patch {
+        exemplar,
+        x0: bx0,
+        y0: by0,
+        grid: rasterize_coords(mesh, deformed, bw, bh, shift)?,
+    })
+}
+
 /// A coordinate field from several warped exemplar segments: owners,
 /// orientation and seam mask.
 fn compose(
     style: &BrushStyle,
     level: usize,
-    fields: &[(u32, Grid<Option<Point>>)],
+    fields: &[Patch],
     owner: &Grid<Option<usize>>,
 ) -> Field {
     let (w, h) = (owner.width(), owner.height());
@@ -246,7 +408,7 @@ fn compose(
     for y in 0..h {
         for x in 0..w {
             let Some(k) = owner.get(x, y) else { continue };
-            let Some((e, g)) = fields.get(k) else {
+            let Some(g) = fields.get(k) else {
                 continue;
             };
             if let Some(c) = g.get(x, y) {
@@ -254,12 +416,12 @@ fn compose(
                     x,
                     y,
                     Some(Coord {
-                        exemplar: *e,
+                        exemplar: g.exemplar,
                         x: c.x as f32,
                         y: c.y as f32,
                     }),
                 );
-                if let Some(o) = orient_of(style, level, *e, g, x, y) {
+                if let Some(o) = orient_of(style, level, g, x, y) {
                     orient.set(x, y, o);
                 }
             }
@@ -327,27 +489,37 @@ fn paper(style: &BrushStyle, level: usize, e: u32, c: Option<Point>) -> Option<f
     Some((0.5 + lv.ink.ink.sample(c.x, c.y)).clamp(0.0, 1.0))
 }
 
-/// Which segment each pixel takes its coordinate from: the first covering
-/// one, then the graph-cut seam between each consecutive pair (§5.3).
+/// Which segment each pixel of a `w` × `h` canvas takes its coordinate
+/// from: the first covering one, then the graph-cut seam between each
+/// consecutive pair (§5.3).
 fn seams(
     style: &BrushStyle,
     level: usize,
-    fields: &[(u32, Grid<Option<Point>>)],
+    fields: &[Patch],
+    (w, h): (usize, usize),
     params: &SeamParams,
 ) -> Result<Grid<Option<usize>>> {
-    let (w, h) = match fields.first() {
-        Some((_, g)) => (g.width(), g.height()),
-        None => return Err(Error::degenerate("brush", "no matched segments")),
-    };
-    let mut owner = Grid::from_fn(w, h, |x, y| {
-        fields.iter().position(|(_, g)| g.get(x, y).is_some())
-    });
+    if fields.is_empty() {
+        return Err(Error::degenerate("brush", "no matched segments"));
+    }
+    let mut owner: Grid<Option<usize>> = Grid::new(w, h, None);
+    for (k, f) in fields.iter().enumerate() {
+        let [x0, y0, x1, y1] = f.bounds();
+        for y in y0..y1.min(h) {
+            for x in x0..x1.min(w) {
+                if owner.get(x, y).is_none() && f.get(x, y).is_some() {
+                    owner.set(x, y, Some(k));
+                }
+            }
+        }
+    }
     for k in 0..fields.len().saturating_sub(1) {
-        let (ea, ga) = (&fields[k].0, &fields[k].1);
-        let (eb, gb) = (&fields[k + 1].0, &fields[k + 1].1);
+        let (ga, gb) = (&fields[k], &fields[k + 1]);
+        let (ea, eb) = (ga.exemplar, gb.exemplar);
+        let (ba, bb) = (ga.bounds(), gb.bounds());
         let (mut x0, mut y0, mut x1, mut y1) = (usize::MAX, usize::MAX, 0, 0);
-        for y in 0..h {
-            for x in 0..w {
+        for y in ba[1].max(bb[1])..ba[3].min(bb[3]).min(h) {
+            for x in ba[0].max(bb[0])..ba[2].min(bb[2]).min(w) {
                 if ga.get(x, y).is_some() && gb.get(x, y).is_some() {
                     (x0, y0, x1, y1) = (x0.min(x), y0.min(y), x1.max(x), y1.max(y));
                 }
@@ -371,10 +543,10 @@ fn seams(
             }
         });
         let a = Grid::from_fn(cw, ch, |x, y| {
-            paper(style, level, *ea, ga.get(x + x0, y + y0)).unwrap_or(1.0)
+            paper(style, level, ea, ga.get(x + x0, y + y0)).unwrap_or(1.0)
         });
         let b = Grid::from_fn(cw, ch, |x, y| {
-            paper(style, level, *eb, gb.get(x + x0, y + y0)).unwrap_or(1.0)
+            paper(style, level, eb, gb.get(x + x0, y + y0)).unwrap_or(1.0)
         });
         let s = seam(&a, &b, &cover, params)?;
         for y in 0..ch {
@@ -427,14 +599,33 @@ fn run_query(
     if levels == 0 || q.samples.len() < 2 {
         return Err(Error::degenerate("brush", "nothing to synthesize"));
     }
-    let factor = 1usize << (levels - 1);
     let ew = exemplar_width(style)?;
-    let canvas = canvas_for(q, ew, factor)?;
-    let scale = 1.0 / canvas.px_per_unit;
+    let start = opts
+        .start_level
+        .unwrap_or_else(|| start_level(style, ew))
+        .min(levels - 1);
+    let top = opts
+        .top_level
+        .unwrap_or_else(|| top_level(style, ew, q.width))
+        .clamp(start, levels - 1);
+    let level_scale = |l: usize| {
+        style
+            .exemplars
+            .first()
+            .and_then(|e| e.levels.get(l))
+            .map_or(1.0, |lv| lv.scale)
+    };
+    let canvas = canvas_for(q, ew * level_scale(top), 1 << (top - start))?;
+    // Finest exemplar px per sketch unit, and per canvas px.
+    let fine = ew / q.width;
+    let sub = output_subdivision(style, canvas.px_per_unit, fine);
+    let canvas_px = (canvas.width as u64).saturating_mul(canvas.height as u64);
+    let most = ((MAX_OUT_PIXELS / canvas_px.max(1)) as f64).sqrt().floor() as usize;
+    let sub = sub.min(most.max(1));
     if opts.art_brush {
-        return art_brush(style, q, canvas, levels);
+        return art_brush(style, q, canvas, top, sub);
     }
-    let h = q.spacing * canvas.px_per_unit;
+    let h = q.spacing * fine;
     // Samples closer than a quarter exemplar pixel: a stroke far wider
     // than it is long, or so short it was sampled below its width's pace.
     if !(h.is_finite() && h >= 0.25) {
@@ -457,7 +648,7 @@ fn run_query(
     }
     let feats: Vec<SpineFeatures> = ribs
         .iter()
-        .map(|r| exemplar_features(r, scale, ew))
+        .map(|r| exemplar_features(r, 1.0 / fine, ew))
         .collect();
     let mopts = MatchOptions {
         seed: opts.seed,
@@ -467,11 +658,7 @@ fn run_query(
     // The beam keeps the best state of every run length, so a complete
     // segmentation survives to the last sample (no exhaustive retry).
     let m = match_query(&qf, &feats, &mopts)?;
-    let start = opts
-        .start_level
-        .unwrap_or_else(|| start_level(style, ew))
-        .min(levels - 1);
-    let div = 1usize << (levels - 1 - start);
+    let div = canvas.factor;
     let coarse = canvas.to_pixel(1.0 / div as f64);
     let (cw, ch) = (canvas.width / div, canvas.height / div);
     let mut fields = Vec::with_capacity(m.segments.len());
@@ -504,16 +691,16 @@ fn run_query(
             .map(|s| coarse * s.pos)
             .collect();
         let out = arap.solve(&pins)?;
-        let grid = rasterize_coords(&mesh, &out, cw, ch, Affine::IDENTITY)?;
-        fields.push((seg.exemplar as u32, grid));
+        fields.push(rasterize_patch(seg.exemplar as u32, &mesh, &out, cw, ch)?);
         segments.push((seg.exemplar, seg.query.clone()));
     }
-    let owner = seams(style, start, &fields, &opts.seams)?;
+    let owner = seams(style, start, &fields, (cw, ch), &opts.seams)?;
     let init = compose(style, start, &fields, &owner);
     if stop_at_init {
         return Ok(QueryResult {
             spine: q.clone(),
             canvas,
+            sub,
             field: init,
             segments,
             levels: Vec::new(),
@@ -523,35 +710,67 @@ fn run_query(
         seed: opts.seed,
         ..opts.synth.clone()
     };
-    let levels = synth::synthesize_levels(style, init, &sopts);
-    let field = levels
-        .last()
-        .cloned()
-        .ok_or_else(|| Error::degenerate("brush", "synthesis produced no level"))?;
+    let mut levels = synth::synthesize_levels(style, init, top, &sopts);
+    // Only a refinement reads the levels again (the top one included).
+    let field = if opts.refine.is_some() {
+        levels.last().cloned()
+    } else {
+        let top = levels.pop();
+        levels.clear();
+        top
+    }
+    .ok_or_else(|| Error::degenerate("brush", "synthesis produced no level"))?;
     Ok(QueryResult {
         spine: q.clone(),
         canvas,
+        sub,
         field,
         segments,
         levels,
     })
 }
 
-/// The art-brush baseline at the finest level: the first exemplar's whole
-/// rib mesh stretched along the query (no matching, seams or synthesis).
+/// A synthesized query carried to the finest level, for refinement (§5.5:
+/// the user's strokes guide every level up to the exemplars' own
+/// resolution): the levels above its top are its top field upsampled
+/// ([`synth::upsample`], no correction, so what the refinement leaves
+/// alone reads as before), on the canvas subdivided to match.
+pub fn to_finest(style: &BrushStyle, mut r: QueryResult) -> QueryResult {
+    let finest = style
+        .exemplars
+        .first()
+        .map_or(0, |e| e.levels.len().saturating_sub(1));
+    let top = r.field.level;
+    if top >= finest {
+        return r;
+    }
+    let mut field = r.field.clone();
+    while field.level < finest {
+        field = synth::upsample(style, &field);
+        r.levels.push(field.clone());
+    }
+    let k = 1usize << (finest - top);
+    r.canvas = r.canvas.subdivided(k);
+    r.sub = r.sub.div_ceil(k).max(1);
+    r.field = field;
+    r
+}
+
+/// The art-brush baseline at level `top`: the first exemplar's whole rib
+/// mesh stretched along the query (no matching, seams or synthesis).
 fn art_brush(
     style: &BrushStyle,
     q: &QuerySpine,
     canvas: Canvas,
-    levels: usize,
+    top: usize,
+    sub: usize,
 ) -> Result<QueryResult> {
-    let finest = levels - 1;
     let ex = style
         .exemplars
         .first()
         .ok_or_else(|| Error::degenerate("brush", "the style has no exemplars"))?;
     let p = |v: &[[f64; 2]]| v.iter().map(|a| Point::new(a[0], a[1])).collect::<Vec<_>>();
-    let r = ex.ribs_at(finest);
+    let r = ex.ribs_at(top);
     let mesh = RibMesh::from_ribs(&p(&r.spine), &p(&r.left), &p(&r.right), 2)?;
     let pts: Vec<Point> = q.samples.iter().map(|s| s.pos).collect();
     let grid = art_brush_coords(
@@ -562,14 +781,20 @@ fn art_brush(
         canvas.height,
         canvas.to_pixel(1.0),
     )?;
-    let fields = vec![(0u32, grid)];
     let owner = Grid::from_fn(canvas.width, canvas.height, |x, y| {
-        fields[0].1.get(x, y).map(|_| 0)
+        grid.get(x, y).map(|_| 0)
     });
-    let field = compose(style, finest, &fields, &owner);
+    let fields = [Patch {
+        exemplar: 0,
+        x0: 0,
+        y0: 0,
+        grid,
+    }];
+    let field = compose(style, top, &fields, &owner);
     Ok(QueryResult {
         spine: q.clone(),
         canvas,
+        sub,
         field,
         segments: Vec::new(),
         levels: Vec::new(),

@@ -11,30 +11,17 @@ use crate::error::{Error, Result};
 use crate::raster::Grid;
 use kurbo::Point;
 
-/// Percentile of the style's rib widths taken as "the exemplar width".
-pub const WIDTH_PERCENTILE: f64 = 0.8;
-
-/// The style's exemplar width, finest px: the [`WIDTH_PERCENTILE`] of all
-/// rib widths (ribs reach the farthest ink, leaves and curls included, so
-/// a high percentile keeps the ornament within the stroke the designer
-/// drew).
+/// The style's exemplar width, finest px ([`crate::brush::analysis::facts::StyleFacts::width`]):
+/// the finest-px width a query's stroke width is mapped to.
 pub fn exemplar_width(style: &BrushStyle) -> Result<f64> {
-    let mut ws: Vec<f64> = style
-        .exemplars
-        .iter()
-        .flat_map(|e| e.ribs.widths())
-        .filter(|w| w.is_finite() && *w > 0.0)
-        .collect();
-    ws.sort_by(f64::total_cmp);
-    let k = ((ws.len() as f64 - 1.0) * WIDTH_PERCENTILE)
-        .round()
-        .max(0.0) as usize;
-    match ws.get(k) {
-        Some(&w) => Ok(w),
-        None => Err(Error::degenerate(
+    let w = style.facts.width;
+    if w.is_finite() && w > 0.0 {
+        Ok(w)
+    } else {
+        Err(Error::degenerate(
             format!("style {}", style.name),
             "its exemplars have no rib widths",
-        )),
+        ))
     }
 }
 

@@ -31,6 +31,7 @@
 //!   Jacobian, so a warped segment is continued as the warp it is.
 
 use crate::brush::analysis::neighbourhood::{Neighbourhood, SIZE};
+use crate::brush::analysis::style::PAPER_LAYER;
 use crate::brush::analysis::{BrushStyle, ExemplarLevel};
 use crate::raster::Grid;
 use crate::rng;
@@ -268,13 +269,8 @@ pub fn layer_at(style: &BrushStyle, level: usize, c: Coord) -> Option<Color> {
         return None;
     }
     // The pixel holding the coordinate: a label needs no interpolation.
-    let (x, y) = (c.x as isize, c.y as isize);
-    lv.ink
-        .layers
-        .iter()
-        .rev()
-        .find(|l| l.sdf.get_or(x, y, 1.0) < 0.0)
-        .map(|l| l.color)
+    let i = lv.top.get_or(c.x as isize, c.y as isize, PAPER_LAYER);
+    lv.ink.layers.get(i as usize).map(|l| l.color)
 }
 
 /// The top layer shown by each pixel of a field (`None`: paper).
@@ -412,6 +408,11 @@ fn agreement(style: &BrushStyle, field: &Field, c: Coord, x: usize, y: usize) ->
     n
 }
 
+/// Largest difference (px of the level, along each axis) between two
+/// candidate coordinates weighed as one: their neighbourhoods differ by
+/// under a quarter of a pixel's shift, well inside [`COHERENT`].
+pub const SAME: f32 = 0.25;
+
 /// The corrected coordinate of one pixel (see the module docs).
 fn correct_pixel(
     style: &BrushStyle,
@@ -429,7 +430,13 @@ fn correct_pixel(
     let l = field.level;
     let mut cands: Vec<(f32, Coord)> = Vec::with_capacity(10);
     if let Some(n) = exemplar_neighbourhood(style, l, cur) {
-        cands.push((cost(&n, cur), cur));
+        let c0 = cost(&n, cur);
+        // An exact match keeps its coordinate (an exemplar copy is a fixed
+        // point): no candidate can do better.
+        if c0 == 0.0 {
+            return Some(cur);
+        }
+        cands.push((c0, cur));
     }
     let (w, h) = (
         field.coords.width() as isize,
@@ -454,7 +461,13 @@ fn correct_pixel(
                 x: cn.x + d[0],
                 y: cn.y + d[1],
             };
-            if cands.iter().any(|(_, o)| *o == c) {
+            // A continuation within [`SAME`] of a candidate already
+            // weighed reads the same neighbourhood: inside a coherent patch
+            // every neighbour continues to the pixel's own coordinate.
+            let same = |o: &Coord| {
+                o.exemplar == c.exemplar && (o.x - c.x).abs() < SAME && (o.y - c.y).abs() < SAME
+            };
+            if cands.iter().any(|(_, o)| same(o)) {
                 continue;
             }
             if let Some(n) = exemplar_neighbourhood(style, l, c) {
@@ -478,11 +491,8 @@ fn correct_pixel(
         .filter(|c| c.0 <= top * (1.0 + opts.tie))
         .map(|c| c.1)
         .collect();
-    // An exact match keeps its coordinate (an exemplar copy is a fixed
-    // point); otherwise near-equal candidates are chosen by the seed.
-    let exact = cands.first().is_some_and(|c| c.1 == cur && c.0 == 0.0);
+    // Near-equal candidates are chosen by the seed.
     let mut pick = match near.len() {
-        _ if exact => cur,
         0 => cur,
         1 => near[0],
         n => near[rng::index(&[opts.seed, l as u64, pass, x as u64, y as u64], n)],
@@ -587,15 +597,21 @@ pub fn upsample(style: &BrushStyle, field: &Field) -> Field {
 }
 
 /// The whole §5.4 pipeline from an initialized coarsest field: correct,
-/// upsample, correct, … up to the finest level of the style, keeping the
-/// corrected field of every level visited, coarse to fine.
-pub fn synthesize_levels(style: &BrushStyle, init: Field, opts: &SynthOptions) -> Vec<Field> {
+/// upsample, correct, … up to level `top` (at most the style's finest),
+/// keeping the corrected field of every level visited, coarse to fine.
+pub fn synthesize_levels(
+    style: &BrushStyle,
+    init: Field,
+    top: usize,
+    opts: &SynthOptions,
+) -> Vec<Field> {
     let levels = style.exemplars.first().map(|e| e.levels.len()).unwrap_or(1);
+    let last = top.min(levels.saturating_sub(1));
     let mut out = Vec::new();
     let mut field = init;
     loop {
         correct(style, &mut field, opts);
-        if field.level + 1 >= levels {
+        if field.level >= last {
             out.push(field);
             return out;
         }

@@ -25,7 +25,7 @@
 //!   covered twice (`cutout-overlaps`).
 
 use crate::brush::measure::{ink, ExemplarFigures, Fidelity};
-use crate::brush::output::brush_sketch;
+use crate::brush::output::{brush_sketch, out_per_fine};
 use crate::brush::pipeline::Settings;
 use crate::fill::continuity::{junctions, pieces, regular_gaps};
 use crate::fill::tile::Tile;
@@ -623,15 +623,17 @@ fn brush(style: &Path, input: &Path) -> Outcome {
         (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for (r, a) in out.queries.iter().zip(&art.queries) {
         let mask = ink(bs, r);
+        // Output px per finest exemplar px, where the exemplars' figures
+        // are measured.
+        let (k, ka) = (out_per_fine(bs, r), out_per_fine(bs, a));
         let f = Fidelity::of(r, &mask);
         coverage.push(f.coverage);
         far.push(f.farthest);
-        debris.push(
-            f.smallest.min(usize::MAX >> 1) as f64 / figures.smallest.min(f.largest).max(1) as f64,
-        );
-        density.push((figures.density_of(r, &mask) / figures.density.max(1e-9) - 1.0).abs());
-        let own = figures.thickness_distance(&mask);
-        let stretched = figures.thickness_distance(&ink(bs, a));
+        let smallest = (figures.smallest as f64 * k * k).round() as usize;
+        debris.push(f.smallest.min(usize::MAX >> 1) as f64 / smallest.min(f.largest).max(1) as f64);
+        density.push((figures.density_of(r, &mask, k) / figures.density.max(1e-9) - 1.0).abs());
+        let own = figures.thickness_distance(&mask, k);
+        let stretched = figures.thickness_distance(&ink(bs, a), ka);
         thickness.push(own / stretched.max(1e-9));
     }
     Ok((

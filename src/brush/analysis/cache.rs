@@ -18,6 +18,7 @@
 //!   analysed again and the file rewritten atomically. Failing to write the
 //!   cache (read-only folder) is not an error.
 
+use super::facts::StyleFacts;
 use super::style::{BrushStyle, Exemplar};
 use crate::brush::analysis::neighbourhood::{NeighbourhoodIndex, NeighbourhoodSampler};
 use crate::error::Result;
@@ -28,7 +29,7 @@ use std::path::{Path, PathBuf};
 
 /// Version of the analysis; bump it whenever the analysis or the cached
 /// types change so old caches are rebuilt.
-pub const ANALYSIS_VERSION: u32 = 5;
+pub const ANALYSIS_VERSION: u32 = 6;
 
 /// Environment variable naming the cache folder (below `--cache`).
 pub const CACHE_ENV: &str = "FLOURISH_CACHE_DIR";
@@ -197,6 +198,7 @@ struct Head {
     resolution: u32,
     sdf: bool,
     sampler: NeighbourhoodSampler,
+    facts: StyleFacts,
 }
 
 /// The file body: the head and one blob per exemplar and per index.
@@ -216,6 +218,7 @@ fn encode(style: &BrushStyle) -> postcard::Result<Vec<u8>> {
         resolution: style.resolution,
         sdf: style.sdf,
         sampler: style.sampler,
+        facts: style.facts.clone(),
     })?;
     let exemplars = style
         .exemplars
@@ -252,6 +255,7 @@ fn decode(bytes: &[u8]) -> Option<BrushStyle> {
         resolution: head.resolution,
         sdf: head.sdf,
         sampler: head.sampler,
+        facts: head.facts,
         exemplars,
         indexes,
     })

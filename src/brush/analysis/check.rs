@@ -126,10 +126,7 @@ impl StyleReport {
                 e.layers.len(),
                 if e.layers.len() == 1 { "" } else { "s" },
                 cols.join(" "),
-                match e.spine_source {
-                    SpineSource::Drawn => "drawn",
-                    SpineSource::Traced => "traced",
-                },
+                e.spine_source.word(),
                 e.spine_length,
                 e.width_range[0],
                 e.width_range[1],
@@ -146,6 +143,9 @@ impl StyleReport {
         s
     }
 }
+
+/// What is said of an exemplar whose ends could not be found.
+pub const FALLBACK_WARNING: &str = "no clear main branch (a dot or a ring?): its spine runs across its longer side; give start and end in style.toml";
 
 /// Checks every exemplar of `style`.
 pub fn check(style: &BrushStyle, opts: &CheckOptions) -> StyleReport {
@@ -200,6 +200,9 @@ fn check_exemplar(e: &Exemplar, opts: &CheckOptions) -> ExemplarReport {
             opts.thin_px,
             thin * 100.0,
         ));
+    }
+    if e.spine_source == SpineSource::Fallback {
+        warnings.push(FALLBACK_WARNING.into());
     }
     if e.features.iter().filter(|f| f.ink == 0.0).count() * 4 > e.features.len() {
         warnings.push("more than a quarter of the ribs cross no ink".into());
@@ -487,6 +490,25 @@ fn draw_panel(pm: &mut tiny_skia::Pixmap, e: &Exemplar, ox: f32, oy: f32) {
     if let (Some(&a), Some(&b)) = (e.spine.first(), e.spine.last()) {
         dot(pm, map(a), [220, 30, 40, 255], 3.5);
         dot(pm, map(b), [20, 170, 40, 255], 3.5);
+        // Ends found by the analysis are ringed (blue), fallback ones in
+        // orange: the designer checks them.
+        let ring = match e.spine_source {
+            SpineSource::Found => Some([40, 90, 220, 255]),
+            SpineSource::Fallback => Some([240, 140, 0, 255]),
+            _ => None,
+        };
+        if let Some(c) = ring {
+            for p in [a, b] {
+                let (cx, cy) = map(p);
+                let circle: Vec<(f32, f32)> = (0..=24)
+                    .map(|k| {
+                        let t = k as f32 / 24.0 * std::f32::consts::TAU;
+                        (cx + 8.0 * t.cos(), cy + 8.0 * t.sin())
+                    })
+                    .collect();
+                line(pm, &circle, c, 2.0);
+            }
+        }
     }
 }
 

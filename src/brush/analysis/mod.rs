@@ -19,7 +19,10 @@
 
 pub mod cache;
 pub mod check;
+pub mod ends;
 pub mod exemplar;
+pub mod facts;
+pub mod init;
 pub mod neighbourhood;
 pub mod spine;
 pub mod style;
@@ -32,6 +35,7 @@ use self::exemplar::LEVELS;
 use self::neighbourhood::{Neighbourhood, NeighbourhoodIndex, NeighbourhoodSampler, Pca, PCA_DIMS};
 use self::spine::SpineOptions;
 use crate::error::{Error, Result};
+use crate::raster::Grid;
 use crate::read::style::{StyleKind, StyleToml, STYLE_FILE};
 
 use kurbo::Point;
@@ -166,12 +170,14 @@ pub fn analyse(
         let points: Vec<[f32; PCA_DIMS]> = all.par_iter().map(|v| pca.project(v)).collect();
         indexes.push(NeighbourhoodIndex::new(pca, points, refs));
     }
+    let exemplars: Vec<Exemplar> = analysed.into_iter().map(|(e, _)| e).collect();
     Ok(BrushStyle {
         name: name.to_string(),
         resolution,
         sdf,
         sampler,
-        exemplars: analysed.into_iter().map(|(e, _)| e).collect(),
+        facts: facts::StyleFacts::of(&exemplars),
+        exemplars,
         indexes,
     })
 }
@@ -205,7 +211,29 @@ fn analyse_exemplar(
         .ok_or_else(|| Error::invalid("no pyramid levels").in_file(&path))?;
     let fine_ppu = fine.px_per_unit;
     let to_fine = |p: Point| Point::new(p.x * fine_ppu, p.y * fine_ppu);
-    let (spine_source, spine, path_px) = match (&ink.drawn_spine, ex.start, ex.end) {
+    // The finest level within the Dijkstra size limit.
+    let dl = (0..ink.levels.len())
+        .rev()
+        .find(|&l| {
+            let g = &ink.levels[l].ink;
+            g.width().max(g.height()) <= DIJKSTRA_MAX_SIDE
+        })
+        .unwrap_or(0);
+    let dlv = &ink.levels[dl];
+    let dppu = dlv.px_per_unit;
+    // Traces the spine between two points of the Dijkstra level (px).
+    let traced = |s: Point, e: Point| -> Result<(Vec<Point>, Vec<Point>)> {
+        let (raw, fit) = spine::trace_spine(&dlv.ink, s, e, &opts.spine)
+            .map_err(|e| Error::invalid(format!("spine: {e}")).in_file(&path))?;
+        let k = fine_ppu / dppu;
+        let up = |p: Point| Point::new(p.x * k, p.y * k);
+        Ok((
+            fit.polyline(400).into_iter().map(up).collect(),
+            raw.into_iter().map(up).collect(),
+        ))
+    };
+    let user = |p: Point, ppu: f64| [p.x / ppu, p.y / ppu];
+    let (spine_source, spine, path_px, ends) = match (&ink.drawn_spine, ex.start, ex.end) {
         (Some(drawn), s, e) if drawn.len() >= 2 => {
             let mut pts: Vec<Point> = drawn.iter().map(|&p| to_fine(p)).collect();
             if let (Some([sx, sy]), Some(_)) = (s, e) {
@@ -215,33 +243,33 @@ fn analyse_exemplar(
                     pts.reverse();
                 }
             }
-            (SpineSource::Drawn, pts, Vec::new())
+            let ends = [user(pts[0], fine_ppu), user(pts[pts.len() - 1], fine_ppu)];
+            (SpineSource::Drawn, pts, Vec::new(), ends)
         }
         (_, Some([sx, sy]), Some([ex_, ey])) => {
-            // The finest level within the Dijkstra size limit.
-            let l = (0..ink.levels.len())
-                .rev()
-                .find(|&l| {
-                    let g = &ink.levels[l].ink;
-                    g.width().max(g.height()) <= DIJKSTRA_MAX_SIDE
-                })
-                .unwrap_or(0);
-            let lv = &ink.levels[l];
-            let s = Point::new(sx * lv.px_per_unit, sy * lv.px_per_unit);
-            let e = Point::new(ex_ * lv.px_per_unit, ey * lv.px_per_unit);
-            let (raw, fit) = spine::trace_spine(&lv.ink, s, e, &opts.spine)
-                .map_err(|e| Error::invalid(format!("spine: {e}")).in_file(&path))?;
-            let k = fine_ppu / lv.px_per_unit;
-            let up = |p: Point| Point::new(p.x * k, p.y * k);
+            let s = Point::new(sx * dppu, sy * dppu);
+            let e = Point::new(ex_ * dppu, ey * dppu);
+            let (spine, raw) = traced(s, e)?;
+            (SpineSource::Traced, spine, raw, [[sx, sy], [ex_, ey]])
+        }
+        (_, None, None) => {
+            let found = ends::find_ends(&dlv.ink, &opts.spine)
+                .ok_or_else(|| Error::invalid("blank exemplar: it has no ink").in_file(&path))?;
+            let source = match found.found {
+                ends::Found::Branch => SpineSource::Found,
+                ends::Found::Fallback => SpineSource::Fallback,
+            };
+            let (spine, raw) = traced(found.start, found.end)?;
             (
-                SpineSource::Traced,
-                fit.polyline(400).into_iter().map(up).collect(),
-                raw.into_iter().map(up).collect(),
+                source,
+                spine,
+                raw,
+                [user(found.start, dppu), user(found.end, dppu)],
             )
         }
         _ => {
             return Err(Error::invalid(format!(
-                "exemplar[{i}]: {} has no path id=\"spine\"; give start and end",
+                "exemplar[{i}]: {} gives only one of start and end; give both, or neither to have them found",
                 ex.file.display()
             ))
             .in_file(toml_path))
@@ -281,11 +309,14 @@ fn analyse_exemplar(
             }
         }
         hoods.push(v);
-        levels.push(ExemplarLevel {
+        let mut level = ExemplarLevel {
             scale,
             ink: lv,
             orientation: field,
-        });
+            top: Grid::new(0, 0, 0),
+        };
+        level.index_layers();
+        levels.push(level);
     }
     let arr = |p: &Point| [p.x, p.y];
     Ok((
@@ -296,6 +327,7 @@ fn analyse_exemplar(
             spine: spine.iter().map(arr).collect(),
             extension,
             path: path_px.iter().map(arr).collect(),
+            ends,
             ribs,
             features,
             levels,

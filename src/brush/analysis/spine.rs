@@ -83,6 +83,121 @@ pub fn exemplar_flow(ink_sdf: &Grid<f32>) -> DirectionGrid {
     edge_tangent_flow(&flow_image(ink_sdf), &EtfOptions::default())
 }
 
+/// The pixel graph of the spine search over a flow field: every pixel
+/// linked to the pixels at the 32 [`link_offsets`], each link costing
+/// `|v| + w_f (1 − f^p) + w_c (1 − c)` (see the module docs).
+pub struct LinkGraph<'a> {
+    flow: &'a DirectionGrid,
+    opts: SpineOptions,
+    /// Offset, length and unit direction of each link.
+    links: Vec<(i32, i32, f64, Vec2)>,
+}
+
+impl<'a> LinkGraph<'a> {
+    /// The graph of `flow` with the path weights `opts`.
+    pub fn new(flow: &'a DirectionGrid, opts: &SpineOptions) -> Self {
+        let links = link_offsets()
+            .into_iter()
+            .map(|(dx, dy)| {
+                let v = Vec2::new(dx as f64, dy as f64);
+                (dx, dy, v.hypot(), v / v.hypot())
+            })
+            .collect();
+        LinkGraph {
+            flow,
+            opts: *opts,
+            links,
+        }
+    }
+
+    /// Grid width, px.
+    pub fn width(&self) -> usize {
+        self.flow.width()
+    }
+
+    /// Grid height, px.
+    pub fn height(&self) -> usize {
+        self.flow.height()
+    }
+
+    /// The flow at a pixel, clamped to the grid.
+    fn at(&self, x: i32, y: i32) -> Vec2 {
+        let (w, h) = (self.width() as i32, self.height() as i32);
+        let d = self
+            .flow
+            .get(x.clamp(0, w - 1) as usize, y.clamp(0, h - 1) as usize);
+        Vec2::new(d[0] as f64, d[1] as f64)
+    }
+
+    /// Calls `visit(j, cost)` for every link out of pixel `i`.
+    pub fn links_from(&self, i: usize, mut visit: impl FnMut(usize, f64)) {
+        let (w, h) = (self.width(), self.height());
+        let unit = |v: Vec2| {
+            let n = v.hypot();
+            if n > 1e-9 {
+                v / n
+            } else {
+                Vec2::ZERO
+            }
+        };
+        let (x, y) = ((i % w) as i32, (i / w) as i32);
+        let here = unit(self.at(x, y));
+        for &(dx, dy, len, dir) in &self.links {
+            let (nx, ny) = (x + dx, y + dy);
+            if nx < 0 || ny < 0 || nx >= w as i32 || ny >= h as i32 {
+                continue;
+            }
+            let j = ny as usize * w + nx as usize;
+            // The flow is unit or zero per pixel; sampled at a link's
+            // midpoint (a half-integer position) it is the mean of the 2 or
+            // 4 pixels around it, exactly what bilinear interpolation gives
+            // there: floor and ceil of x + dx/2, y + dy/2.
+            let (mx0, mx1) = ((2 * x + dx).div_euclid(2), (2 * x + dx + 1).div_euclid(2));
+            let (my0, my1) = ((2 * y + dy).div_euclid(2), (2 * y + dy + 1).div_euclid(2));
+            let mid =
+                unit(self.at(mx0, my0) + self.at(mx1, my0) + self.at(mx0, my1) + self.at(mx1, my1));
+            let there = unit(self.at(nx, ny));
+            let f = dir.dot(mid).abs();
+            let c = here.dot(there).abs();
+            let o = &self.opts;
+            visit(
+                j,
+                len + o.w_flow * (1.0 - f.powi(o.power)) + o.w_curvature * (1.0 - c),
+            );
+        }
+    }
+
+    /// The least-cost distance from pixel `from` to every pixel, with the
+    /// pixels where `blocked` is true left out (Dijkstra's algorithm);
+    /// infinite where none reaches.
+    pub fn distances(&self, from: usize, blocked: Option<&[bool]>) -> Vec<f64> {
+        let n = self.width() * self.height();
+        let mut dist = vec![f64::INFINITY; n];
+        let Some(d0) = dist.get_mut(from) else {
+            return dist;
+        };
+        *d0 = 0.0;
+        let mut heap = BinaryHeap::new();
+        heap.push((Reverse(Cost(0.0)), from));
+        while let Some((Reverse(Cost(d)), i)) = heap.pop() {
+            if d > dist[i] {
+                continue;
+            }
+            self.links_from(i, |j, cost| {
+                if blocked.is_some_and(|b| b.get(j).copied().unwrap_or(true)) {
+                    return;
+                }
+                let nd = d + cost;
+                if nd < dist[j] {
+                    dist[j] = nd;
+                    heap.push((Reverse(Cost(nd)), j));
+                }
+            });
+        }
+        dist
+    }
+}
+
 /// The least-cost path from `start` to `end` (pixel coordinates of `flow`'s
 /// grid) over the 32-neighbour pixel graph; its first and last vertices are
 /// `start` and `end` themselves, the others pixel centres.
@@ -102,31 +217,7 @@ pub fn shortest_path(
         y * w + x
     };
     let (s, e) = (pixel(start), pixel(end));
-    let links: Vec<(i32, i32, f64, Vec2)> = link_offsets()
-        .into_iter()
-        .map(|(dx, dy)| {
-            let v = Vec2::new(dx as f64, dy as f64);
-            (dx, dy, v.hypot(), v / v.hypot())
-        })
-        .collect();
-    // The flow is unit or zero per pixel; sampled at a link's midpoint (a
-    // half-integer position) it is the mean of the 2 or 4 pixels around it,
-    // exactly what bilinear interpolation gives there.
-    let at = |x: i32, y: i32| -> Vec2 {
-        let d = flow.get(
-            x.clamp(0, w as i32 - 1) as usize,
-            y.clamp(0, h as i32 - 1) as usize,
-        );
-        Vec2::new(d[0] as f64, d[1] as f64)
-    };
-    let unit = |v: Vec2| {
-        let n = v.hypot();
-        if n > 1e-9 {
-            v / n
-        } else {
-            Vec2::ZERO
-        }
-    };
+    let graph = LinkGraph::new(flow, opts);
     let mut dist = vec![f64::INFINITY; w * h];
     let mut parent = vec![usize::MAX; w * h];
     // A*: every link costs at least its length, so the straight distance
@@ -144,30 +235,14 @@ pub fn shortest_path(
         if d > dist[i] {
             continue;
         }
-        let (x, y) = ((i % w) as i32, (i / w) as i32);
-        let here = unit(at(x, y));
-        for &(dx, dy, len, dir) in &links {
-            let (nx, ny) = (x + dx, y + dy);
-            if nx < 0 || ny < 0 || nx >= w as i32 || ny >= h as i32 {
-                continue;
-            }
-            let j = ny as usize * w + nx as usize;
-            // Pixels around the midpoint: floor and ceil of x + dx/2, y + dy/2.
-            let (mx0, mx1) = ((2 * x + dx).div_euclid(2), (2 * x + dx + 1).div_euclid(2));
-            let (my0, my1) = ((2 * y + dy).div_euclid(2), (2 * y + dy + 1).div_euclid(2));
-            let mid = unit(at(mx0, my0) + at(mx1, my0) + at(mx0, my1) + at(mx1, my1));
-            let there = unit(at(nx, ny));
-            let f = dir.dot(mid).abs();
-            let c = here.dot(there).abs();
-            let cost =
-                len + opts.w_flow * (1.0 - f.powi(opts.power)) + opts.w_curvature * (1.0 - c);
+        graph.links_from(i, |j, cost| {
             let nd = d + cost;
             if nd < dist[j] {
                 dist[j] = nd;
                 parent[j] = i;
                 heap.push((Reverse(Cost(nd + to_end(j))), Reverse(Cost(nd)), j));
             }
-        }
+        });
     }
     if !dist[e].is_finite() {
         return Err(Error::invalid("no path between start and end").in_file("spine"));
@@ -199,7 +274,7 @@ pub fn shortest_path(
 
 /// A total order on finite path costs for the heap.
 #[derive(Clone, Copy, PartialEq)]
-struct Cost(f64);
+pub(crate) struct Cost(pub(crate) f64);
 
 impl Eq for Cost {}
 

@@ -3,12 +3,15 @@
 //! What [`super::cache`] stores and [`super::BrushStyle::load`] returns.
 
 use super::exemplar::{InkLevel, LEVELS};
+use super::facts::StyleFacts;
 #[cfg(test)]
 use super::neighbourhood::Neighbourhood;
 use super::neighbourhood::{
     NeighbourhoodIndex, NeighbourhoodRef, NeighbourhoodSampler, PCA_DIMS, SIZE,
 };
 use super::uv::{OrientationField, Ribs, SampleFeatures};
+use crate::raster::Grid;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 
@@ -19,6 +22,24 @@ pub enum SpineSource {
     Drawn,
     /// Traced between `start` and `end` (Dijkstra + quartic).
     Traced,
+    /// Traced between ends found at the two ends of the main branch
+    /// ([`super::ends`]), `style.toml` giving none.
+    Found,
+    /// Traced across the exemplar's longer side: `style.toml` gives no
+    /// ends and the drawing has no clear main branch (a dot, a ring).
+    Fallback,
+}
+
+impl SpineSource {
+    /// One word for reports.
+    pub fn word(self) -> &'static str {
+        match self {
+            SpineSource::Drawn => "drawn",
+            SpineSource::Traced => "traced",
+            SpineSource::Found => "found",
+            SpineSource::Fallback => "fallback",
+        }
+    }
 }
 
 /// One exemplar at one pyramid level.
@@ -31,9 +52,35 @@ pub struct ExemplarLevel {
     pub ink: InkLevel,
     /// Per-pixel stroking orientation and the stroke-region mask.
     pub orientation: OrientationField,
+    /// Per pixel, the index of the top layer with ink there (in
+    /// `ink.layers`), [`PAPER_LAYER`] on paper: one read instead of a
+    /// search through the layers ([`ExemplarLevel::index_layers`]; derived,
+    /// not cached).
+    #[serde(skip, default = "no_layers")]
+    pub top: Grid<u8>,
+}
+
+/// The [`ExemplarLevel::top`] index of paper.
+pub const PAPER_LAYER: u8 = u8::MAX;
+
+fn no_layers() -> Grid<u8> {
+    Grid::new(0, 0, PAPER_LAYER)
 }
 
 impl ExemplarLevel {
+    /// Sets [`ExemplarLevel::top`] from the layers (layers beyond the
+    /// 255th count as the 255th).
+    pub fn index_layers(&mut self) {
+        let layers = &self.ink.layers;
+        let (w, h) = (self.ink.ink.width(), self.ink.ink.height());
+        self.top = Grid::from_fn(w, h, |x, y| {
+            layers
+                .iter()
+                .rposition(|l| l.sdf.get_or(x as isize, y as isize, 1.0) < 0.0)
+                .map_or(PAPER_LAYER, |i| i.min(PAPER_LAYER as usize - 1) as u8)
+        });
+    }
+
     /// Width in pixels.
     pub fn width(&self) -> usize {
         self.ink.ink.width()
@@ -63,6 +110,9 @@ pub struct Exemplar {
     pub extension: [f64; 2],
     /// The raw Dijkstra path (finest px) when the spine was traced.
     pub path: Vec<[f64; 2]>,
+    /// The spine's start and end in the exemplar's user units: as given,
+    /// drawn, or found ([`SpineSource`]).
+    pub ends: [[f64; 2]; 2],
     /// Rib samples (30–100), finest px.
     pub ribs: Ribs,
     /// Per-sample features, parallel to the ribs.
@@ -102,6 +152,9 @@ pub struct BrushStyle {
     pub sampler: NeighbourhoodSampler,
     /// The exemplars in `style.toml` order.
     pub exemplars: Vec<Exemplar>,
+    /// The style's figures as a whole (exemplar width, smallest element,
+    /// thinnest line, palette).
+    pub facts: StyleFacts,
     /// Per level (coarse to fine), the neighbourhoods of all exemplars'
     /// stroke regions, searchable.
     pub indexes: Vec<NeighbourhoodIndex>,
@@ -117,6 +170,7 @@ impl BrushStyle {
             .iter_mut()
             .flat_map(|e| e.levels.iter_mut())
             .all(|l| l.ink.restore_ink());
+        self.index_layers();
         let exemplars: Vec<&Exemplar> = self.exemplars.iter().collect();
         let refs: Vec<Vec<NeighbourhoodRef>> = (0..self.indexes.len())
             .map(|l| region_refs(&exemplars, l))
@@ -125,6 +179,14 @@ impl BrushStyle {
             idx.refs = r;
         }
         inks
+    }
+
+    /// Sets every level's top-layer index ([`ExemplarLevel::index_layers`]).
+    pub fn index_layers(&mut self) {
+        self.exemplars
+            .par_iter_mut()
+            .flat_map(|e| e.levels.par_iter_mut())
+            .for_each(ExemplarLevel::index_layers);
     }
 
     /// Structural consistency (sizes agree everywhere, references in
