@@ -2036,3 +2036,24 @@ fn styles_are_listed_and_close_names_suggested() {
     assert_eq!(code(&o), Some(1), "stderr: {}", stderr(&o));
     assert!(stderr(&o).contains("did you mean knot"), "{}", stderr(&o));
 }
+
+/// `--invert` traces the paper as black ink (it used to take the paper's
+/// own colour: white shapes on a white preview).
+#[test]
+fn invert_traces_the_paper_as_black_ink() {
+    for sample in ["glyph-a-binary.png", "ornament-scroll.png", "glyph-s.svg"] {
+        let out = Command::new(env!("CARGO_BIN_EXE_flourish"))
+            .args(["trace", "--invert", "-o", "-"])
+            .arg(
+                PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+                    .join("samples/trace")
+                    .join(sample),
+            )
+            .output()
+            .expect("runs");
+        assert!(out.status.success(), "{sample}");
+        let svg = String::from_utf8_lossy(&out.stdout);
+        assert!(svg.contains("fill=\"#000\""), "{sample}: {svg}");
+        assert!(!svg.contains("fill=\"#fff"), "{sample}: white ink");
+    }
+}

@@ -268,7 +268,12 @@ pub(super) fn pixel_coverage(
                 .collect(),
         )
         .expect("sizes match");
-        let color = mean_ink_colour(px, &cov);
+        // Traced paper is drawn as black ink: its own colour is the paper's.
+        let color = if opts.invert {
+            Color::BLACK
+        } else {
+            mean_ink_colour(px, &cov)
+        };
         // A binary bitmap stands for a smooth outline within half a pixel
         // of its staircase (see `binary`); anti-aliased coverage says where
         // the edge is.
@@ -344,10 +349,11 @@ fn grey_coverage(grey: &image::GrayImage, invert: bool) -> RasterCoverage {
             n += u64::from(count);
         }
     }
-    let color = sum.checked_div(n).map_or(Color::BLACK, |g| {
-        let g = g as u8;
-        Color::rgb(g, g, g)
-    });
+    // Traced paper is drawn as black ink: its own colour is the paper's.
+    let color = match sum.checked_div(n) {
+        Some(g) if !invert => Color::rgb(g as u8, g as u8, g as u8),
+        _ => Color::BLACK,
+    };
     if binary && raw.len() == w * h {
         // Straight to the ink bitmap: no coverage grid in between.
         let bits = Bitmap::from_rows(w, h, raw, |&v| level[usize::from(v)] >= 0.5);
@@ -960,10 +966,10 @@ mod tests {
                 n += 1;
             }
         }
-        let color = sum.checked_div(n).map_or(Color::BLACK, |g| {
-            let g = g as u8;
-            Color::rgb(g, g, g)
-        });
+        let color = match sum.checked_div(n) {
+            Some(g) if !invert => Color::rgb(g as u8, g as u8, g as u8),
+            _ => Color::BLACK,
+        };
         (crate::raster::is_binary(&cov), color, cov)
     }
 
