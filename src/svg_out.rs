@@ -202,7 +202,7 @@ impl Document {
 
     /// Merges the shapes of each group that share fill, fill rule, stroke
     /// and opacity into one path each, when the document holds more than
-    /// [`MAX_ELEMENTS`] shapes; returns the note saying so, if it did. The
+    /// `MAX_ELEMENTS` (200 000) shapes; returns the note saying so, if it did. The
     /// drawing is unchanged: the shapes' subpaths keep their own
     /// orientation, so holes stay holes under their fill rule.
     pub fn merge_past_limit(&mut self) -> Option<String> {

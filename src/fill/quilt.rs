@@ -111,7 +111,7 @@ impl Quilter {
         }
     }
 
-    /// [`quilt`] with these tables: the same map. `source` must be the
+    /// `quilt` with these tables: the same map. `source` must be the
     /// source this was made for; when `o.block` or the atlas differs from
     /// what it was made for, a matching one is made first.
     pub fn quilt(
@@ -129,7 +129,7 @@ impl Quilter {
     }
 }
 
-/// The quilting loop of [`quilt`].
+/// The quilting loop of `quilt`.
 fn quilt_blocks(
     q: &Quilter,
     source: &Source,

@@ -232,7 +232,7 @@ pub fn load_traceable(path: &Path, opts: &ImageOptions) -> Result<Traceable> {
     read_traceable(&bytes, opts).map_err(|e| e.in_file(path))
 }
 
-/// Reads raster or SVG bytes for tracing: like [`read`], except that a
+/// Reads raster or SVG bytes for tracing: like `read`, except that a
 /// raster comes back as the outlines of its layers.
 pub fn read_traceable(bytes: &[u8], opts: &ImageOptions) -> Result<Traceable> {
     if looks_like_svg(bytes) {
@@ -265,7 +265,7 @@ pub fn read_traceable(bytes: &[u8], opts: &ImageOptions) -> Result<Traceable> {
     }))
 }
 
-/// Raster bytes (PNG, JPEG, …) read as ink, as [`read`] reads them.
+/// Raster bytes (PNG, JPEG, …) read as ink, as `read` reads them.
 pub fn read_raster(bytes: &[u8], opts: &ImageOptions) -> Result<Ink> {
     Ok(coverage_ink(
         raster_coverage(bytes, opts)?.0,
@@ -441,7 +441,7 @@ fn read_svg(bytes: &[u8], opts: &ImageOptions) -> Result<Ink> {
     Ok(ink)
 }
 
-/// The ink of a parsed SVG `tree` as [`read`] reads SVG; paths whose `id` is `skip_id` are left out
+/// The ink of a parsed SVG `tree` as `read` reads SVG; paths whose `id` is `skip_id` are left out
 /// (a brush exemplar's hand-drawn `id="spine"` is not ink).
 pub fn svg_ink(tree: &usvg::Tree, opts: &ImageOptions, skip_id: Option<&str>) -> Result<Ink> {
     let size = tree.size();

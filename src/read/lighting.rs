@@ -168,7 +168,7 @@ impl Lighting {
         (self.brightest / paper) as f32
     }
 
-    /// The gains of row `y` (see [`Lighting::gain`]), pixel by pixel: the
+    /// The gains of row `y` (see `Lighting::gain`), pixel by pixel: the
     /// surface along a row is a cubic in `u` whose coefficients are read
     /// off the two-variable one once per row and evaluated by Horner's
     /// rule (the same polynomial, to rounding).
