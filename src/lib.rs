@@ -491,14 +491,22 @@ pub fn init_style(dir: &Path, resolution: Option<u32>) -> Result<InitReport> {
     brush::analysis::init::init(dir, resolution)
 }
 
-/// Analyses a brush style for `flourish style check`: a report per
-/// exemplar (spine, widths, thin lines) with warnings where the library
-/// will not brush well.
+/// Analyses a style for `flourish style check`: for a brush style a
+/// report per exemplar (spine, widths, thin lines) with warnings where the
+/// library will not brush well; for a fill style each swatch's size,
+/// repeat and colour layers with their coverage; for a pattern style its
+/// elements, arrangement and spacing.
 pub fn check_style(style: &Style) -> Result<StyleReport> {
-    Ok(brush::analysis::check::check(
-        style.brush()?,
-        &brush::analysis::check::CheckOptions::default(),
-    ))
+    Ok(match style.kind() {
+        StyleKind::Brush => brush::analysis::check::check(
+            style.brush()?,
+            &brush::analysis::check::CheckOptions::default(),
+        ),
+        StyleKind::Fill => StyleReport::summary(style.name(), "fill", fill::check(style.fill()?)),
+        StyleKind::Pattern => {
+            StyleReport::summary(style.name(), "pattern", pattern::check(style.pattern()?))
+        }
+    })
 }
 
 /// A brush style's diagnostics sheet as PNG bytes: per exemplar its ink,

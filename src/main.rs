@@ -61,7 +61,7 @@ struct StyleArgs {
 
 #[derive(Subcommand)]
 enum StyleCommand {
-    /// Analyse a brush library: a report per exemplar, warnings, and a diagnostics sheet.
+    /// Analyse a style: a report per exemplar, warnings, and (brush) a diagnostics sheet.
     Check(StyleCheckArgs),
     /// List every style that --styles, $FLOURISH_STYLES and the shipped styles hold.
     List(StyleListArgs),
@@ -92,7 +92,7 @@ struct StyleInitArgs {
 
 #[derive(Args)]
 struct StyleCheckArgs {
-    /// Brush style: a folder holding style.toml, or a name in --styles.
+    /// Style: a folder holding style.toml, or a name in --styles.
     #[arg(value_name = "STYLE")]
     style: String,
     /// Write the diagnostics sheet (spine, ribs, orientation field) to this PNG.
@@ -1073,12 +1073,18 @@ fn run_style_check(args: StyleCheckArgs, quiet: bool) -> Result<(), Failure> {
     let style = library(&args.styles).load(
         &args.style,
         &StyleOptions {
-            kind: Some(StyleKind::Brush),
             cache_dir: args.cache,
             use_cache: !args.no_cache,
             ..StyleOptions::default()
         },
     )?;
+    if args.sheet.is_some() && style.kind() != StyleKind::Brush {
+        return Err(Failure::Usage(format!(
+            "--sheet draws brush exemplars; {} is a {} style",
+            args.style,
+            style.kind().name()
+        )));
+    }
     if let Some(sheet) = &args.sheet {
         // The sheet must not replace the style's own files.
         for file in style.files() {

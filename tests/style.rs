@@ -115,11 +115,32 @@ fn bad_styles_fail_with_one_clear_line() {
         false,
         &["style.toml", "resolution"],
     );
-    assert_one_line_error(
-        "kind = \"pattern\"\nscale = 2.0\n[[exemplar]]\nfile = \"a.svg\"\n",
-        false,
-        &["kind", "brush"],
+}
+
+/// `style check` reports every kind of style: a fill style's swatches
+/// (size, repeat, colour layers and their coverage) and a pattern style's
+/// elements and spacing; the diagnostics sheet stays a brush sheet.
+#[test]
+fn style_check_reports_fill_and_pattern_styles() {
+    let out = flourish(&["style", "check", "knot"]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.starts_with("style knot: fill"), "{text}");
+    assert!(
+        text.contains("tile.svg: 96×96 px, seamless tile, 2 layers bottom first (#22324f"),
+        "{text}"
     );
+    let out = flourish(&["style", "check", "hatching"]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.starts_with("style hatching: pattern"), "{text}");
+    assert!(text.contains("elements in a row"), "{text}");
+    let tmp = tempfile::tempdir().unwrap();
+    let sheet = tmp.path().join("sheet.png");
+    let out = flourish(&["style", "check", "stipple", "--sheet", s(&sheet)]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("pattern style"));
+    assert!(!sheet.exists());
 }
 
 #[test]

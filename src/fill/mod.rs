@@ -561,3 +561,44 @@ fn mostly_inside(outline: &BezPath, rule: FillRule, pts: &[Point]) -> bool {
 
 #[cfg(test)]
 mod tests;
+
+/// One line per swatch of `style` for `flourish style check`: its file,
+/// raster size, whether it repeats (a seamless tile), is a motif on paper
+/// or a piece of a larger pattern, and each colour layer, bottom first,
+/// with the share of the swatch it covers (a layer covers the layers above
+/// it too).
+pub fn check(style: &FillStyle) -> Vec<String> {
+    let mut lines: Vec<String> = style
+        .files
+        .iter()
+        .zip(&style.tiles)
+        .map(|(file, t)| {
+            let (w, h) = (t.colour.width(), t.colour.height());
+            let repeat = if t.periodic {
+                "seamless tile"
+            } else if t.shape.is_some() {
+                "motif on paper"
+            } else {
+                "piece of a larger pattern"
+            };
+            let layers: Vec<String> = t
+                .layers
+                .iter()
+                .map(|l| {
+                    let inside = l.sdf.data().iter().filter(|d| **d < 0.0).count();
+                    let share = inside as f64 / l.sdf.data().len().max(1) as f64;
+                    format!("{} {:.0}%", l.color.to_hex(), share * 100.0)
+                })
+                .collect();
+            format!(
+                "{file}: {w}×{h} px, {repeat}, {} layer{} bottom first ({}) on {}",
+                t.layers.len(),
+                if t.layers.len() == 1 { "" } else { "s" },
+                layers.join(", "),
+                t.paper.to_hex()
+            )
+        })
+        .collect();
+    lines.extend(style.notes.iter().cloned());
+    lines
+}

@@ -518,3 +518,28 @@ fn place(style: &PatternStyle, p: Placed, at: Point, angle: f64) -> PlacedElemen
 
 #[cfg(test)]
 mod tests;
+
+/// One line for `flourish style check`: the example's elements (how many,
+/// their sizes), whether they form a row or a field, and their spacing,
+/// in example units.
+pub fn check(style: &PatternStyle) -> Vec<String> {
+    let els = &style.reference.elements;
+    let (lo, hi) = els
+        .iter()
+        .map(|e| e.length().max(e.thickness()))
+        .fold((f64::INFINITY, 0.0f64), |(lo, hi), s| {
+            (lo.min(s), hi.max(s))
+        });
+    let dim = match style.reference.dist.dim {
+        Dim::One => "a row",
+        Dim::Two => "a field",
+    };
+    vec![format!(
+        "{} elements in {dim}, {:.1}–{:.1} units across, spacing {:.1} units (ε = {})",
+        els.len(),
+        if lo.is_finite() { lo } else { 0.0 },
+        hi,
+        style.reference.dist.spacing,
+        style.params.scale
+    )]
+}

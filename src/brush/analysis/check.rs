@@ -79,6 +79,9 @@ pub struct StyleReport {
     pub(crate) neighbourhoods: Vec<usize>,
     /// One report per exemplar.
     pub(crate) exemplars: Vec<ExemplarReport>,
+    /// For a fill or pattern style: its kind and one line per exemplar
+    /// (empty for a brush style, whose exemplars are reported above).
+    pub(crate) summary: Option<(&'static str, Vec<String>)>,
 }
 
 impl StyleReport {
@@ -103,6 +106,14 @@ impl StyleReport {
     /// The report as text, one exemplar per block.
     pub fn to_text(&self) -> String {
         let mut s = String::new();
+        if let Some((kind, lines)) = &self.summary {
+            let _ = writeln!(s, "style {}: {kind}", self.name);
+            for l in lines {
+                let _ = writeln!(s, "  {l}");
+            }
+            let _ = writeln!(s, "0 warnings");
+            return s;
+        }
         let lv: Vec<String> = self.levels.iter().map(|l| l.to_string()).collect();
         let nb: Vec<String> = self.neighbourhoods.iter().map(|l| l.to_string()).collect();
         let _ = writeln!(
@@ -144,6 +155,20 @@ impl StyleReport {
     }
 }
 
+impl StyleReport {
+    /// The report of a fill or pattern style named `name`: its kind and a
+    /// line per exemplar.
+    pub(crate) fn summary(name: &str, kind: &'static str, lines: Vec<String>) -> StyleReport {
+        StyleReport {
+            name: name.to_string(),
+            levels: Vec::new(),
+            neighbourhoods: Vec::new(),
+            exemplars: Vec::new(),
+            summary: Some((kind, lines)),
+        }
+    }
+}
+
 /// What is said of an exemplar whose ends could not be found.
 pub const FALLBACK_WARNING: &str = "no clear main branch (a dot or a ring?): its spine runs across its longer side; give start and end in style.toml";
 
@@ -168,6 +193,7 @@ pub fn check(style: &BrushStyle, opts: &CheckOptions) -> StyleReport {
             .iter()
             .map(|e| check_exemplar(e, opts))
             .collect(),
+        summary: None,
     }
 }
 
