@@ -28,6 +28,33 @@ pub struct Link {
 }
 
 impl Link {
+    /// The four links around the cell whose top-left sample is `(x, y)`,
+    /// clockwise (y down) from its top: top, right, bottom, left.
+    pub fn around(x: i32, y: i32) -> [Link; 4] {
+        [
+            Link {
+                horizontal: true,
+                x,
+                y,
+            },
+            Link {
+                horizontal: false,
+                x: x + 1,
+                y,
+            },
+            Link {
+                horizontal: true,
+                x,
+                y: y + 1,
+            },
+            Link {
+                horizontal: false,
+                x,
+                y,
+            },
+        ]
+    }
+
     /// The two samples the link joins (first, second), unpadded coordinates.
     pub fn ends(self) -> ((i32, i32), (i32, i32)) {
         if self.horizontal {
@@ -222,28 +249,7 @@ pub fn extract(values: &Grid<f32>) -> Vec<Contour> {
             }
             // Cell edges in clockwise order (y down): top a→b, right b→c,
             // bottom c→d, left d→a.
-            let edges = [
-                Link {
-                    horizontal: true,
-                    x,
-                    y,
-                },
-                Link {
-                    horizontal: false,
-                    x: x + 1,
-                    y,
-                },
-                Link {
-                    horizontal: true,
-                    x,
-                    y: y + 1,
-                },
-                Link {
-                    horizontal: false,
-                    x,
-                    y,
-                },
-            ];
+            let edges = Link::around(x, y);
             let corner = [a, b, c, d];
             let saddle = case == 5 || case == 10;
             let centre_inside = saddle && {

@@ -128,6 +128,20 @@ impl Grid<f32> {
     }
 }
 
+/// The row-major indices of the 4-neighbours of pixel `i` of a `w`×`h`
+/// grid that lie inside it: left, right, up, down.
+pub fn neighbours4(i: usize, w: usize, h: usize) -> impl Iterator<Item = usize> {
+    let (x, y) = (i % w, i / w);
+    [
+        (x > 0).then(|| i - 1),
+        (x + 1 < w).then(|| i + 1),
+        (y > 0).then(|| i - w),
+        (y + 1 < h).then(|| i + w),
+    ]
+    .into_iter()
+    .flatten()
+}
+
 /// `x` (finite, at least 0) rounded to the nearest integer, halves away
 /// from zero, as `f32::round` does, without the library call that the
 /// baseline x86-64 instruction set needs for it (the difference from the

@@ -160,7 +160,6 @@ impl Partition {
             let mut borders = [0usize; MAX_COLOURS];
             while let Some(i) = stack.pop() {
                 region.push(i);
-                let (x, y) = (i % w, i / w);
                 let mut visit = |j: usize| {
                     let m = self.labels[j];
                     if m == l {
@@ -172,17 +171,8 @@ impl Partition {
                         *b += 1;
                     }
                 };
-                if x > 0 {
-                    visit(i - 1);
-                }
-                if x + 1 < w {
-                    visit(i + 1);
-                }
-                if y > 0 {
-                    visit(i - w);
-                }
-                if y + 1 < h {
-                    visit(i + w);
+                for j in super::neighbours4(i, w, h) {
+                    visit(j);
                 }
             }
             if (region.len() as f64) >= min_area {
@@ -224,16 +214,7 @@ impl Partition {
         if !(c > 0.5 / 255.0 && c < 1.0 - 0.5 / 255.0) {
             return None;
         }
-        let at = |dx: i32, dy: i32| self.share_or_0(x + dx, y + dy, l);
-        let r2 = std::f64::consts::SQRT_2;
-        let gx = at(1, -1) + r2 * at(1, 0) + at(1, 1) - at(-1, -1) - r2 * at(-1, 0) - at(-1, 1);
-        let gy = at(-1, 1) + r2 * at(0, 1) + at(1, 1) - at(-1, -1) - r2 * at(0, -1) - at(1, -1);
-        let g = Vec2::new(gx, gy);
-        let len = g.hypot();
-        if len < 1e-3 {
-            return None;
-        }
-        let n = g / len;
+        let n = super::sdf::edge_normal(|dx, dy| self.share_or_0(x + dx, y + dy, l))?;
         Some((n, super::sdf::edge_offset(n, c)))
     }
 
@@ -359,28 +340,7 @@ pub fn boundaries(p: &Partition) -> Boundaries {
             if c[0] == c[1] && c[1] == c[2] && c[2] == c[3] {
                 continue;
             }
-            let edges = [
-                Link {
-                    horizontal: true,
-                    x,
-                    y,
-                },
-                Link {
-                    horizontal: false,
-                    x: x + 1,
-                    y,
-                },
-                Link {
-                    horizontal: true,
-                    x,
-                    y: y + 1,
-                },
-                Link {
-                    horizontal: false,
-                    x,
-                    y,
-                },
-            ];
+            let edges = Link::around(x, y);
             let crossed: Vec<usize> = (0..4).filter(|&k| c[k] != c[(k + 1) % 4]).collect();
             let mut distinct = c.to_vec();
             distinct.sort_unstable();

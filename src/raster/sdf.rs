@@ -307,6 +307,22 @@ pub fn edge_offset(n: Vec2, a: f64) -> f64 {
 
 /// The edge model of pixel `(x, y)`, when it is partially covered and its
 /// coverage gradient is well defined.
+/// The unit normal of a straight edge through a pixel, into the ink: the
+/// isotropic 3×3 gradient (weights 1, √2, 1) of the coverage `at(dx, dy)`
+/// of the pixel's neighbours; `None` where it is flat.
+pub fn edge_normal(at: impl Fn(i32, i32) -> f64) -> Option<Vec2> {
+    let r2 = std::f64::consts::SQRT_2;
+    let gx = at(1, -1) + r2 * at(1, 0) + at(1, 1) - at(-1, -1) - r2 * at(-1, 0) - at(-1, 1);
+    let gy = at(-1, 1) + r2 * at(0, 1) + at(1, 1) - at(-1, -1) - r2 * at(0, -1) - at(1, -1);
+    let g = Vec2::new(gx, gy);
+    let len = g.hypot();
+    if len < 1e-3 {
+        return None;
+    }
+    let n = g / len;
+    Some(n)
+}
+
 fn edge_model(cov: &Coverage, x: i32, y: i32) -> Option<EdgeModel> {
     let c = cov.get_or(x as isize, y as isize, 0.0);
     if !(c > COVERAGE_EPS && c < 1.0 - COVERAGE_EPS) {
@@ -331,17 +347,7 @@ fn edge_model(cov: &Coverage, x: i32, y: i32) -> Option<EdgeModel> {
             }
         }
     }
-    let at = |dx: i32, dy: i32| near[(dy + 1) as usize][(dx + 1) as usize];
-    // Isotropic 3×3 gradient (weights 1, √2, 1).
-    let r2 = std::f64::consts::SQRT_2;
-    let gx = at(1, -1) + r2 * at(1, 0) + at(1, 1) - at(-1, -1) - r2 * at(-1, 0) - at(-1, 1);
-    let gy = at(-1, 1) + r2 * at(0, 1) + at(1, 1) - at(-1, -1) - r2 * at(0, -1) - at(1, -1);
-    let g = Vec2::new(gx, gy);
-    let len = g.hypot();
-    if len < 1e-3 {
-        return None;
-    }
-    let n = g / len;
+    let n = edge_normal(|dx, dy| near[(dy + 1) as usize][(dx + 1) as usize])?;
     Some(EdgeModel {
         n,
         d: edge_offset(n, c as f64),

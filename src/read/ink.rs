@@ -136,14 +136,7 @@ pub fn read_regions(bytes: &[u8], opts: &ImageOptions) -> Result<RegionInk> {
         pixmap.fill(tiny_skia::Color::WHITE);
         let canvas = tiny_skia::Transform::from_scale(scale as f32, scale as f32);
         resvg::render(&tree, canvas, &mut pixmap.as_mut());
-        let px: Vec<[u8; 4]> = pixmap
-            .pixels()
-            .iter()
-            .map(|p| {
-                let c = p.demultiply();
-                [c.red(), c.green(), c.blue(), c.alpha()]
-            })
-            .collect();
+        let px = rgba(&pixmap);
         let (partition, colours) = super::image::pixel_partition(&px, pw, ph)?;
         return Ok(RegionInk {
             width: uw,
@@ -407,14 +400,7 @@ fn rendered_ink(
             }
         }
     }
-    let px: Vec<[u8; 4]> = pixmap
-        .pixels()
-        .iter()
-        .map(|p| {
-            let c = p.demultiply();
-            [c.red(), c.green(), c.blue(), c.alpha()]
-        })
-        .collect();
+    let px = rgba(&pixmap);
     let size = tree.size();
     Ok(Ink {
         width: size.width() as f64,
@@ -595,4 +581,16 @@ fn gradient_fills(group: &usvg::Group) -> usize {
             _ => 0,
         })
         .sum()
+}
+
+/// The pixels of a rendered pixmap as straight (not premultiplied) RGBA.
+fn rgba(pixmap: &tiny_skia::Pixmap) -> Vec<[u8; 4]> {
+    pixmap
+        .pixels()
+        .iter()
+        .map(|p| {
+            let c = p.demultiply();
+            [c.red(), c.green(), c.blue(), c.alpha()]
+        })
+        .collect()
 }

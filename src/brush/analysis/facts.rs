@@ -146,24 +146,14 @@ pub fn components(mask: &Grid<bool>) -> Vec<Vec<usize>> {
         let mut k = 0;
         while let Some(&i) = comp.get(k) {
             k += 1;
-            let (x, y) = (i % w, i / w);
             let mut visit = |j: usize| {
                 if !seen[j] && mask.data()[j] {
                     seen[j] = true;
                     comp.push(j);
                 }
             };
-            if x > 0 {
-                visit(i - 1);
-            }
-            if x + 1 < w {
-                visit(i + 1);
-            }
-            if y > 0 {
-                visit(i - w);
-            }
-            if y + 1 < h {
-                visit(i + w);
+            for j in crate::raster::neighbours4(i, w, h) {
+                visit(j);
             }
         }
         out.push(comp);
