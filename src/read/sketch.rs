@@ -180,6 +180,7 @@ pub fn parse(data: &[u8]) -> Result<Sketch> {
         styles: &pre.styles,
         exemplars: &pre.exemplars,
         elements: &pre.elements,
+        placed: std::collections::BTreeSet::new(),
         backdrop: Backdrop {
             text: text.to_string(),
             end: pre.end,
@@ -221,6 +222,8 @@ struct Read<'a> {
     styles: &'a BTreeMap<String, String>,
     exemplars: &'a BTreeMap<String, String>,
     elements: &'a BTreeMap<String, Element>,
+    /// The elements a query has already taken the place of.
+    placed: std::collections::BTreeSet<String>,
     backdrop: Backdrop,
 }
 
@@ -392,7 +395,7 @@ impl Read<'_> {
         let Some(el) = self.elements.get(element) else {
             return;
         };
-        if self.backdrop.places.values().any(|p| p.range == el.range) {
+        if !self.placed.insert(element.to_string()) {
             return;
         }
         self.backdrop.places.insert(
