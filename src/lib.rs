@@ -284,8 +284,9 @@ pub fn decorate(sketch: &Sketch, styles: Decoration, opts: &DecorateOptions) -> 
     opts.validate()?;
     styles.validate()?;
     let mut warnings = Vec::new();
-    // The queries of each style, in the order styles first appear.
-    let mut runs: Vec<(&Style, Vec<usize>)> = Vec::new();
+    // The styles in the order they first appear, and each query's.
+    let mut runs: Vec<&Style> = Vec::new();
+    let mut run_of: Vec<Option<usize>> = vec![None; sketch.queries.len()];
     for (i, q) in sketch.queries.iter().enumerate() {
         let style = match &q.style {
             Some(name) => Some(styles.named.get(name).ok_or_else(|| {
@@ -310,24 +311,18 @@ pub fn decorate(sketch: &Sketch, styles: Decoration, opts: &DecorateOptions) -> 
             ));
             continue;
         }
-        match runs.iter_mut().find(|(s, _)| std::ptr::eq(*s, style)) {
-            Some((_, qs)) => qs.push(i),
-            None => runs.push((style, vec![i])),
-        }
-    }
-    let decorated: Vec<bool> = {
-        let mut d = vec![false; sketch.queries.len()];
-        for (_, qs) in &runs {
-            for &i in qs {
-                d[i] = true;
+        run_of[i] = Some(match runs.iter().position(|s| std::ptr::eq(*s, style)) {
+            Some(r) => r,
+            None => {
+                runs.push(style);
+                runs.len() - 1
             }
-        }
-        d
-    };
+        });
+    }
     let mut notes = Vec::new();
     let mut groups: BTreeMap<String, std::collections::VecDeque<Group>> = BTreeMap::new();
     let mut decimals = 0;
-    for (style, qs) in &runs {
+    for (r, style) in runs.iter().enumerate() {
         let mut part = sketch.clone();
         part.notes.clear();
         part.warnings.clear();
@@ -336,11 +331,9 @@ pub fn decorate(sketch: &Sketch, styles: Decoration, opts: &DecorateOptions) -> 
             .queries
             .iter()
             .enumerate()
-            .filter(|(i, q)| {
-                qs.contains(i)
-                    || style.kind() == StyleKind::Fill
-                        && !decorated[*i]
-                        && matches!(q.kind, QueryKind::Path { .. })
+            .filter(|(i, q)| match run_of[*i] {
+                Some(own) => own == r,
+                None => style.kind() == StyleKind::Fill && matches!(q.kind, QueryKind::Path { .. }),
             })
             .map(|(_, q)| Query {
                 style: None,
