@@ -5,15 +5,17 @@
 //!   file (name and bytes, in `style.toml` order). Editing any of them, or
 //!   a new analysis version, gives a new key and a new file.
 //! * File: `NAME-KEY.bin` in the cache folder: a magic tag, the version,
-//!   the full key, then the analysis in postcard with grids as byte
+//!   the full key, a blake3 checksum of the body, then as the body the
+//!   analysis in postcard with grids as byte
 //!   strings ([`crate::raster::plain`]) so it loads at memory speed; each
 //!   exemplar and each level's index is its own postcard blob, so they
 //!   decode in parallel.
 //! * Folder: [`AnalysisOptions::cache_dir`](super::AnalysisOptions::cache_dir)
 //!   (`--cache DIR`), else `$FLOURISH_CACHE_DIR`, else the platform's cache
 //!   folder (`~/.cache/flourish/styles` on Linux).
-//! * A file that is missing, of another version or key, truncated, corrupt
-//!   or inconsistent (sizes that disagree, see
+//! * A file that is missing, not a regular file (a FIFO or device is never
+//!   opened), of another version or key, whose body does not match its
+//!   checksum, truncated, corrupt or inconsistent (sizes that disagree, see
 //!   [`super::style::BrushStyle::validate`]) is never trusted: the style is
 //!   analysed again and the file rewritten atomically. Failing to write the
 //!   cache (read-only folder) is not an error.
@@ -29,7 +31,7 @@ use std::path::{Path, PathBuf};
 
 /// Version of the analysis; bump it whenever the analysis or the cached
 /// types change so old caches are rebuilt.
-pub const ANALYSIS_VERSION: u32 = 6;
+pub const ANALYSIS_VERSION: u32 = 7;
 
 /// Environment variable naming the cache folder (below `--cache`).
 pub const CACHE_ENV: &str = "FLOURISH_CACHE_DIR";
@@ -111,19 +113,30 @@ pub enum Read {
     Found(Box<BrushStyle>),
 }
 
-/// Reads the analysis stored in `path` for `key`, checking tag, version,
-/// key, decoding and consistency.
+/// Length of the file's header: tag, version, key and checksum.
+const HEAD_LEN: usize = MAGIC.len() + 4 + 32 + 32;
+
+/// Reads the analysis stored in `path` for `key`, checking that it is a
+/// regular file (before opening it), then tag, version, key, the body's
+/// checksum, decoding and consistency.
 pub fn read(path: &Path, key: &[u8; 32]) -> Read {
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_file() => {}
+        Ok(_) => return Read::Unusable,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Read::Missing,
+        Err(_) => return Read::Unusable,
+    }
     let bytes = match std::fs::read(path) {
         Ok(b) => b,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Read::Missing,
         Err(_) => return Read::Unusable,
     };
-    let head = MAGIC.len() + 4 + 32;
+    let head = HEAD_LEN;
     if bytes.len() < head
         || &bytes[..8] != MAGIC
         || bytes[8..12] != ANALYSIS_VERSION.to_le_bytes()
         || &bytes[12..44] != key
+        || bytes[44..76] != *blake3::hash(&bytes[head..]).as_bytes()
     {
         return Read::Unusable;
     }
@@ -144,13 +157,14 @@ pub fn write(path: &Path, key: &[u8; 32], style: &BrushStyle) -> Result<()> {
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir).map_err(|e| crate::error::Error::io(dir, e))?;
     }
-    let mut bytes = Vec::with_capacity(1 << 20);
-    bytes.extend_from_slice(MAGIC);
-    bytes.extend_from_slice(&ANALYSIS_VERSION.to_le_bytes());
-    bytes.extend_from_slice(key);
     let body = encode(style).map_err(|e| {
         crate::error::Error::invalid(format!("cannot encode the analysis: {e}")).in_file(path)
     })?;
+    let mut bytes = Vec::with_capacity(HEAD_LEN + body.len());
+    bytes.extend_from_slice(MAGIC);
+    bytes.extend_from_slice(&ANALYSIS_VERSION.to_le_bytes());
+    bytes.extend_from_slice(key);
+    bytes.extend_from_slice(blake3::hash(&body).as_bytes());
     bytes.extend_from_slice(&body);
     io::write_atomic(path, &bytes)?;
     remove_stale(path);

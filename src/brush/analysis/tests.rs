@@ -46,31 +46,48 @@ fn cache_hits_misses_and_rebuilds_corrupt_files() {
     assert_eq!(files.len(), 1, "{files:?}");
     let file = &files[0];
     let good = std::fs::read(file).unwrap();
-    // Truncated, garbage, a flipped size byte deep inside, and empty: each is
-    // rebuilt, never trusted, never a panic; the rebuilt file is then a hit.
+    // Truncated, garbage, a run of flipped bytes deep inside, 16 single
+    // bytes flipped at spread positions of the body, and empty: the
+    // checksum or the header refuses each; it is rebuilt, never trusted,
+    // never a panic, and the rebuilt file is then a hit.
     let mut flipped = good.clone();
     let mid = flipped.len() / 2;
     for b in &mut flipped[mid..mid + 64] {
         *b ^= 0x5a;
     }
+    let mut spread = good.clone();
+    let body = 76..spread.len();
+    for k in 0..16 {
+        let at = body.start + (k * 7919 + 13) % body.len();
+        spread[at] ^= 1 << (k % 8);
+    }
     let variants: Vec<Vec<u8>> = vec![
         good[..good.len() / 3].to_vec(),
         b"not a cache at all".to_vec(),
         flipped,
+        spread,
         Vec::new(),
     ];
     for bad in variants {
         std::fs::write(file, &bad).unwrap();
         let (style, st) = BrushStyle::load_with_status(&dir, &opts).unwrap();
-        // A flip inside sample data can decode; it must then still be
-        // consistent. Every other variant must be rebuilt.
-        if st == CacheStatus::Hit {
-            assert!(style.validate());
-        } else {
-            assert_eq!(st, CacheStatus::Rebuilt);
-            assert_eq!(postcard::to_stdvec(&style).unwrap(), bytes);
+        assert_eq!(st, CacheStatus::Rebuilt);
+        assert_eq!(postcard::to_stdvec(&style).unwrap(), bytes);
+        let (_, st) = BrushStyle::load_with_status(&dir, &opts).unwrap();
+        assert_eq!(st, CacheStatus::Hit);
+    }
+    // A FIFO in the cache file's place is never opened (opening it would
+    // block): it is replaced by a rebuilt file.
+    #[cfg(unix)]
+    {
+        std::fs::remove_file(file).unwrap();
+        let made = std::process::Command::new("mkfifo").arg(file).status();
+        if made.map(|s| s.success()).unwrap_or(false) {
             let (_, st) = BrushStyle::load_with_status(&dir, &opts).unwrap();
-            assert_eq!(st, CacheStatus::Hit);
+            assert_eq!(st, CacheStatus::Rebuilt);
+            assert!(std::fs::metadata(file).unwrap().is_file());
+        } else {
+            std::fs::write(file, &good).unwrap();
         }
     }
     // Editing an exemplar changes the key: a miss, not the old analysis,
