@@ -29,6 +29,14 @@ pub fn stage() -> String {
     STAGE.lock().map(|s| s.clone()).unwrap_or_default()
 }
 
+/// Calls `f` with the stage, without allocating and without waiting: not
+/// at all while another thread is setting it (for last-resort messages).
+pub fn with_stage(f: impl FnOnce(&str)) {
+    if let Ok(s) = STAGE.try_lock() {
+        f(&s);
+    }
+}
+
 /// Sets the stage [`stage`] reports.
 pub(crate) fn set_stage(what: impl Into<String>) {
     if let Ok(mut s) = STAGE.lock() {

@@ -45,6 +45,7 @@ mod fill;
 mod gallery;
 pub mod io;
 mod library;
+pub mod memory;
 mod outline;
 mod pattern;
 mod raster;

@@ -33,6 +33,10 @@ struct Cli {
     /// End the run after this many seconds: exit 1, no output file left half-written.
     #[arg(long, global = true, value_name = "SECONDS")]
     timeout: Option<f64>,
+    /// Most memory the run may hold, in MB or with a unit (512M, 2G); default 1G.
+    /// Resolution is lowered to fit where a mode can, else the run ends with one line.
+    #[arg(long, global = true, value_name = "SIZE")]
+    max_memory: Option<String>,
 }
 
 #[derive(Subcommand)]
@@ -332,7 +336,16 @@ fn main() -> ExitCode {
             return ExitCode::SUCCESS;
         }
     };
-    match run(cli) {
+    let verbose = cli.verbose;
+    let result = run(cli);
+    if verbose {
+        eprintln!(
+            "flourish: peak memory {} of the {} budget",
+            flourish::memory::in_words(flourish::memory::peak()),
+            flourish::memory::in_words(flourish::memory::budget())
+        );
+    }
+    match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(Failure::Usage(msg)) => {
             eprintln!("flourish: {msg}");
@@ -355,6 +368,21 @@ fn main() -> ExitCode {
 const MAX_THREADS: usize = 1024;
 
 fn run(cli: Cli) -> Result<(), Failure> {
+    let budget = match &cli.max_memory {
+        Some(text) => parse_size(text).ok_or_else(|| {
+            Failure::Usage(format!(
+                "--max-memory {text:?} is not a size (a number of MB, or with a unit: 512M, 2G)"
+            ))
+        })?,
+        None => flourish::memory::DEFAULT_BUDGET,
+    };
+    if budget < MIN_BUDGET {
+        return Err(Failure::Usage(format!(
+            "--max-memory must be at least {}",
+            flourish::memory::in_words(MIN_BUDGET)
+        )));
+    }
+    flourish::memory::set_budget(budget);
     if let Some(t) = cli.timeout {
         if !(t.is_finite() && t > 0.0 && t <= 1e6) {
             return Err(Failure::Usage(format!(
@@ -760,6 +788,7 @@ fn run_jobs(
                 ));
             }
             let inp = &inputs[0];
+            budget::running_on(shown(inp));
             let _ticker = Ticker::start(shown(inp), quiet);
             // `-o DIR/` (or an existing folder) writes NAME.svg into it.
             let into = |p: &Path, name: PathBuf| -> Result<PathBuf, Failure> {
@@ -1132,3 +1161,191 @@ fn run_style_list(args: StyleListArgs) -> Result<(), Failure> {
     }
     Ok(())
 }
+
+/// Smallest `--max-memory`: what reading a small sketch and a style takes.
+const MIN_BUDGET: u64 = 16 << 20;
+
+/// A size of `--max-memory`: a number of MB, or a number with a unit
+/// K, M, G (optionally followed by B or iB), in bytes.
+fn parse_size(text: &str) -> Option<u64> {
+    let t = text.trim();
+    let t = t
+        .strip_suffix("iB")
+        .or_else(|| t.strip_suffix("B"))
+        .or_else(|| t.strip_suffix('b'))
+        .unwrap_or(t);
+    let (number, scale) = match t.char_indices().last() {
+        Some((i, c)) if c.is_ascii_alphabetic() => {
+            let scale: u64 = match c.to_ascii_uppercase() {
+                'K' => 1 << 10,
+                'M' => 1 << 20,
+                'G' => 1 << 30,
+                'T' => 1 << 40,
+                _ => return None,
+            };
+            (&t[..i], scale)
+        }
+        _ => (t, 1 << 20),
+    };
+    let n: f64 = number.trim().parse().ok()?;
+    let bytes = n * scale as f64;
+    (n.is_finite() && n > 0.0 && bytes < 2f64.powi(62)).then_some(bytes as u64)
+}
+
+/// The budget's last resort: every heap allocation of the program is
+/// counted ([`flourish::memory::reserve`]); one that would cross
+/// `--max-memory` ends the run with one line and exit 1 instead of an
+/// allocation abort. The modes check their large canvases against the
+/// budget before allocating them, so this is reached only by what no
+/// estimate covered.
+mod budget {
+    use std::alloc::{GlobalAlloc, Layout, System};
+    use std::sync::Mutex;
+
+    /// The input being worked on, for the last-resort message.
+    static INPUT: Mutex<String> = Mutex::new(String::new());
+
+    /// Names the input the run is working on.
+    pub fn running_on(input: &std::path::Path) {
+        let name = input.display().to_string();
+        if let Ok(mut i) = INPUT.lock() {
+            *i = name;
+        }
+    }
+
+    /// The system allocator, counted against the budget.
+    pub struct Counting;
+
+    // SAFETY: every call is forwarded to `System` with the same layout and
+    // pointer; the counting around it neither allocates nor locks.
+    unsafe impl GlobalAlloc for Counting {
+        unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+            if !flourish::memory::reserve(layout.size()) {
+                over_budget(layout.size());
+            }
+            // SAFETY: forwarded with the caller's layout.
+            let p = unsafe { System.alloc(layout) };
+            if p.is_null() {
+                flourish::memory::release(layout.size());
+            }
+            p
+        }
+
+        unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+            if !flourish::memory::reserve(layout.size()) {
+                over_budget(layout.size());
+            }
+            // SAFETY: forwarded with the caller's layout.
+            let p = unsafe { System.alloc_zeroed(layout) };
+            if p.is_null() {
+                flourish::memory::release(layout.size());
+            }
+            p
+        }
+
+        unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+            // SAFETY: `ptr` was allocated by `System` with `layout`.
+            unsafe { System.dealloc(ptr, layout) };
+            flourish::memory::release(layout.size());
+        }
+
+        unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+            let old = layout.size();
+            if new_size > old && !flourish::memory::reserve(new_size - old) {
+                over_budget(new_size - old);
+            }
+            // SAFETY: `ptr` was allocated by `System` with `layout`.
+            let p = unsafe { System.realloc(ptr, layout, new_size) };
+            if p.is_null() {
+                if new_size > old {
+                    flourish::memory::release(new_size - old);
+                }
+            } else if new_size < old {
+                flourish::memory::release(old - new_size);
+            }
+            p
+        }
+    }
+
+    /// A fixed buffer that formats without allocating.
+    struct Line {
+        bytes: [u8; 512],
+        len: usize,
+    }
+
+    impl std::fmt::Write for Line {
+        fn write_str(&mut self, s: &str) -> std::fmt::Result {
+            let room = self.bytes.len() - self.len;
+            let n = s.len().min(room);
+            self.bytes[self.len..self.len + n].copy_from_slice(&s.as_bytes()[..n]);
+            self.len += n;
+            Ok(())
+        }
+    }
+
+    /// Writes one line naming the input, the stage and the budget to
+    /// stderr and ends the process with exit 1, allocating nothing and
+    /// waiting for no lock.
+    #[cold]
+    fn over_budget(asked: usize) -> ! {
+        use std::fmt::Write as _;
+        let mut line = Line {
+            bytes: [0; 512],
+            len: 0,
+        };
+        let _ = line.write_str("flourish: ");
+        if let Ok(input) = INPUT.try_lock() {
+            if !input.is_empty() {
+                let _ = write!(line, "{input}: ");
+            }
+        }
+        let budget = flourish::memory::budget();
+        let _ = write!(
+            line,
+            "out of memory: {} more would pass the memory budget of {}",
+            Mb(asked as u64),
+            Mb(budget)
+        );
+        flourish::io::with_stage(|stage| {
+            if !stage.is_empty() {
+                let _ = write!(line, " during {stage}");
+            }
+        });
+        let _ = line.write_str(" (--max-memory to change it)\n");
+        end(&line.bytes[..line.len])
+    }
+
+    /// A byte count in MB or GB, formatted without allocating.
+    struct Mb(u64);
+
+    impl std::fmt::Display for Mb {
+        fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+            let mb = self.0 as f64 / (1u64 << 20) as f64;
+            if mb >= 1024.0 {
+                write!(f, "{:.1} GB", mb / 1024.0)
+            } else {
+                write!(f, "{mb:.0} MB")
+            }
+        }
+    }
+
+    #[cfg(unix)]
+    fn end(line: &[u8]) -> ! {
+        // SAFETY: `line` is a valid buffer of its length; `_exit` ends the
+        // process without running anything that could allocate.
+        unsafe {
+            libc::write(2, line.as_ptr().cast(), line.len());
+            libc::_exit(1)
+        }
+    }
+
+    #[cfg(not(unix))]
+    fn end(line: &[u8]) -> ! {
+        use std::io::Write as _;
+        let _ = std::io::stderr().write_all(line);
+        std::process::exit(1)
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: budget::Counting = budget::Counting;

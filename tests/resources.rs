@@ -1,6 +1,9 @@
-//! Bounded time: `--timeout` ends a run cleanly (exit 1, one line, no
-//! output file and no temporary file left, an existing output untouched),
-//! and a run that lasts shows what it is doing on stderr.
+//! Bounded time and memory: `--timeout` ends a run cleanly (exit 1, one
+//! line, no output file and no temporary file left, an existing output
+//! untouched), a run that lasts shows what it is doing on stderr, and
+//! `--max-memory` caps what a run holds: a mode refuses a canvas over it
+//! before allocating, and any allocation past it ends the run with one
+//! line instead of an abort.
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -102,4 +105,104 @@ fn a_run_that_lasts_shows_its_stage() {
         "{}",
         String::from_utf8_lossy(&quiet.stderr)
     );
+}
+
+/// Runs `args` and asserts a clean refusal: exit 1, one stderr line that
+/// names `input` and contains `cause`, and nothing left in `dir`.
+#[track_caller]
+fn refused(dir: &std::path::Path, args: &[&str], input: &str, cause: &str) {
+    let run = flourish().args(args).output().expect("runs");
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(1), "{args:?}: {err}");
+    assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
+    assert!(
+        err.contains(input) && err.contains(cause),
+        "{args:?}: {err}"
+    );
+    let left: Vec<_> = std::fs::read_dir(dir).expect("the folder").collect();
+    assert!(left.is_empty(), "{args:?}: nothing written: {left:?}");
+}
+
+#[test]
+fn a_canvas_over_the_memory_budget_is_refused_before_it_is_allocated() {
+    let dir = folder("budget-estimate");
+    let letter = root().join("samples/fill/letter.svg");
+    let out = dir.join("letter.svg");
+    let args = [
+        "--max-memory",
+        "300M",
+        "fill",
+        "--style",
+        "knot",
+        "--resolution",
+        "1024",
+        letter.to_str().expect("utf-8"),
+        "-o",
+        out.to_str().expect("utf-8"),
+    ];
+    refused(&dir, &args, "letter.svg", "memory budget");
+    // At the style's own resolution the letter fits the same budget.
+    let mut fits = args.to_vec();
+    fits.drain(5..7);
+    let run = flourish().args(&fits).output().expect("runs");
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+}
+
+#[test]
+fn an_allocation_past_the_budget_ends_the_run_with_one_line() {
+    // A 4000×4000 px drawing traced under 16 MB: decoding it alone takes
+    // more, and no estimate stands in the way, so the last resort answers.
+    let dir = folder("budget-guard");
+    let src = folder("budget-guard-input");
+    let png = src.join("big.png");
+    let img = image::GrayImage::from_fn(4000, 4000, |x, y| {
+        let (dx, dy) = (x as f64 - 2000.0, y as f64 - 2000.0);
+        image::Luma([if dx * dx + dy * dy < 1.5e6 { 0 } else { 255 }])
+    });
+    img.save(&png).expect("a PNG");
+    let out = dir.join("big.svg");
+    refused(
+        &dir,
+        &[
+            "--max-memory",
+            "16M",
+            "trace",
+            png.to_str().expect("utf-8"),
+            "-o",
+            out.to_str().expect("utf-8"),
+        ],
+        "big.png",
+        "memory budget of 16 MB",
+    );
+}
+
+#[test]
+fn max_memory_takes_a_size_and_verbose_reports_the_peak() {
+    let dir = folder("budget-sizes");
+    let letter = root().join("samples/fill/letter.svg");
+    for good in ["512", "512M", "1G", "1.5GB", "2GiB"] {
+        let run = flourish()
+            .args(["-v", "--max-memory", good, "fill", "--style", "knot"])
+            .arg(&letter)
+            .arg("-o")
+            .arg(dir.join("letter.svg"))
+            .output()
+            .expect("runs");
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert!(run.status.success(), "--max-memory {good}: {err}");
+        assert!(err.contains("flourish: peak memory "), "{err}");
+    }
+    for bad in ["0", "-5", "lots", "1X", "1", "nan", "1e30G"] {
+        let run = flourish()
+            .args(["--max-memory", bad, "style", "list"])
+            .output()
+            .expect("runs");
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(2), "--max-memory {bad}: {err}");
+        assert_eq!(err.lines().count(), 1, "{err}");
+    }
 }

@@ -229,6 +229,11 @@ pub fn output_subdivision(style: &BrushStyle, ppu: f64, fine: f64) -> usize {
 /// is about 1.8 GB, twenty times the largest canvas of the shipped samples.
 pub const MAX_BRUSH_PIXELS: u64 = 16 << 20;
 
+/// Bytes a brush query holds per canvas pixel of its top level at its
+/// peak (fields of every level, Jacobians, layer SDFs, the traced
+/// output), for the memory budget's estimate.
+pub const BYTES_PER_CANVAS_PX: u64 = 180;
+
 /// Largest output grid of one brush query, pixels in all (32 Mpx, about
 /// 30 bytes each: the layers' SDFs and the ink mask); a finer one is not
 /// allocated, the subdivision is lowered instead.
@@ -604,7 +609,7 @@ fn run_query(
         .start_level
         .unwrap_or_else(|| start_level(style, ew))
         .min(levels - 1);
-    let top = opts
+    let mut top = opts
         .top_level
         .unwrap_or_else(|| top_level(style, ew, q.width))
         .clamp(start, levels - 1);
@@ -615,7 +620,25 @@ fn run_query(
             .and_then(|e| e.levels.get(l))
             .map_or(1.0, |lv| lv.scale)
     };
-    let canvas = canvas_for(q, ew * level_scale(top), 1 << (top - start))?;
+    // A stroke too long for its canvas at the level the output asks for
+    // is synthesized at a coarser level that fits the size limit and the
+    // memory budget; at the coarsest it is refused with the canvas named.
+    let canvas = loop {
+        let fits = canvas_for(q, ew * level_scale(top), 1 << (top - start)).and_then(|c| {
+            let bytes = (c.width as u64)
+                .saturating_mul(c.height as u64)
+                .saturating_mul(BYTES_PER_CANVAS_PX);
+            let what = format!(
+                "the {}×{} px canvas of query {}",
+                c.width, c.height, q.query_id
+            );
+            crate::memory::check(&what, bytes).map(|()| c)
+        });
+        match fits {
+            Err(_) if top > start => top -= 1,
+            other => break other?,
+        }
+    };
     // Finest exemplar px per sketch unit, and per canvas px.
     let fine = ew / q.width;
     let sub = output_subdivision(style, canvas.px_per_unit, fine);

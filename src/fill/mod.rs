@@ -436,6 +436,8 @@ pub fn fill_sketch<'s>(
     for (qi, (q, outline, rule)) in regions.into_iter().enumerate() {
         let (name, st) = style_of(q)?;
         let which = exemplars_of(sk, q, name, st, opts)?;
+        let margin = st.params.radius + 2;
+        check_memory(&q.id, outline, st.px_per_unit(sk), margin, &which, st)?;
         let k = match prepared_styles
             .iter()
             .position(|(s, w, _)| std::ptr::eq(*s, st) && *w == which)
@@ -454,7 +456,6 @@ pub fn fill_sketch<'s>(
         let prepared = &prepared_styles[k].2;
         let ppu = st.px_per_unit(sk);
         max_ppu = max_ppu.max(ppu);
-        let margin = st.params.radius + 2;
         let mut region = Region::rasterize(&q.id, outline, rule, ppu, margin)?;
         if let Flow::Fixed(d) = st.flow {
             region.direction = constant_field(region.width(), region.height(), d);
@@ -601,4 +602,42 @@ pub fn check(style: &FillStyle) -> Vec<String> {
         .collect();
     lines.extend(style.notes.iter().cloned());
     lines
+}
+
+/// Bytes a region's synthesis holds per pixel of its grid and of its
+/// swatches at their peak (pyramids, patch features, nearest-neighbour
+/// fields, layer SDFs), for the memory budget's estimate.
+const BYTES_PER_PX: u64 = 180;
+
+/// Refuses, before its grid is allocated, a region whose synthesis would
+/// not fit the memory budget ([`crate::memory`]): its grid at `ppu` with
+/// `margin` and the swatches `which` of `st`.
+fn check_memory(
+    id: &str,
+    outline: &BezPath,
+    ppu: f64,
+    margin: usize,
+    which: &[usize],
+    st: &FillStyle,
+) -> Result<()> {
+    let bb = outline.bounding_box();
+    let side = |l: f64| (l * ppu).ceil().clamp(0.0, 1e9) as u64 + 2 * margin as u64;
+    let grid = side(bb.width()).saturating_mul(side(bb.height()));
+    let swatches: u64 = which
+        .iter()
+        .filter_map(|&i| st.tiles.get(i))
+        .filter_map(|t| t.layers.first())
+        .map(|l| (l.sdf.width() as u64) * (l.sdf.height() as u64))
+        .sum();
+    let what = format!(
+        "region {id}: a {}×{} px grid with {} swatch px",
+        side(bb.width()),
+        side(bb.height()),
+        swatches
+    );
+    crate::memory::check(
+        &what,
+        grid.saturating_add(swatches).saturating_mul(BYTES_PER_PX),
+    )
+    .map_err(|e| Error::invalid(format!("{e}; lower --resolution")))
 }
