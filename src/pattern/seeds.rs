@@ -90,11 +90,15 @@ impl Region {
         if bad {
             return Err("outline has non-finite coordinates".into());
         }
-        if let Some(p) = first_crossing(&rings_pts) {
-            return Err(format!(
-                "outline is self-intersecting near ({:.1}, {:.1})",
-                p.x, p.y
-            ));
+        // Rings that cross are resolved by the fill rule into rings that
+        // do not (outer boundaries and holes, nonzero = even-odd after).
+        let (rings_pts, rule) = if first_crossing(&rings_pts).is_some() {
+            (resolve_crossings(&rings_pts, rule), FillRule::NonZero)
+        } else {
+            (rings_pts, rule)
+        };
+        if rings_pts.is_empty() {
+            return Err("region has zero area".into());
         }
         let mut rings: Vec<Ring> = rings_pts
             .into_iter()
@@ -273,6 +277,30 @@ fn first_crossing(rings: &[Vec<Point>]) -> Option<Point> {
         }
     }
     best.map(|b| b.2)
+}
+
+/// The rings bounding what `rings` cover under `rule`, crossing nowhere:
+/// outer boundaries and holes of opposite orientation, which touch at
+/// most at vertices (the Boolean union of a polygon with itself, as
+/// vector editors compute it).
+fn resolve_crossings(rings: &[Vec<Point>], rule: FillRule) -> Vec<Vec<Point>> {
+    use i_overlay::core::fill_rule::FillRule as Rule;
+    use i_overlay::float::simplify::SimplifyShape as _;
+    let contours: Vec<Vec<[f64; 2]>> = rings
+        .iter()
+        .map(|r| r.iter().map(|p| [p.x, p.y]).collect())
+        .collect();
+    let rule = match rule {
+        FillRule::NonZero => Rule::NonZero,
+        FillRule::EvenOdd => Rule::EvenOdd,
+    };
+    contours
+        .simplify_shape(rule)
+        .into_iter()
+        .flatten()
+        .filter(|c| c.len() >= 3)
+        .map(|c| c.into_iter().map(|[x, y]| Point::new(x, y)).collect())
+        .collect()
 }
 
 /// The crossing point of segments ab and cd when they cross properly (or
@@ -667,15 +695,81 @@ mod tests {
     }
 
     #[test]
-    fn bowtie_is_self_intersecting() {
+    fn a_bowtie_is_two_triangles() {
         let mut p = BezPath::new();
         p.move_to((0.0, 0.0));
         p.line_to((10.0, 10.0));
         p.line_to((10.0, 0.0));
         p.line_to((0.0, 10.0));
         p.close_path();
-        let e = Region::new(&p, FillRule::NonZero, 0.1).unwrap_err();
-        assert!(e.contains("self-intersecting"), "{e}");
+        for rule in [FillRule::NonZero, FillRule::EvenOdd] {
+            let r = Region::new(&p, rule, 0.1).unwrap();
+            assert_eq!(r.rings.len(), 2);
+            assert!((r.area - 50.0).abs() < 1e-6, "{}", r.area);
+            assert!(r.contains(Point::new(1.0, 5.0)) && r.contains(Point::new(9.0, 5.0)));
+            assert!(!r.contains(Point::new(5.0, 1.0)) && !r.contains(Point::new(5.0, 9.0)));
+        }
+    }
+
+    #[test]
+    fn a_pentagram_fills_by_its_rule() {
+        // Drawn in one stroke: nonzero fills the centre, even-odd leaves
+        // it out. Area of the centre pentagon and of the five tips, exact
+        // from the crossing points, against the resolved rings' area.
+        let pts = [
+            (50.0, 0.0),
+            (21.0, 90.0),
+            (98.0, 35.0),
+            (2.0, 35.0),
+            (79.0, 90.0),
+        ];
+        let mut p = BezPath::new();
+        p.move_to(pts[0]);
+        for &q in &pts[1..] {
+            p.line_to(q);
+        }
+        p.close_path();
+        let centre = Point::new(50.0, 50.0);
+        let nz = Region::new(&p, FillRule::NonZero, 0.1).unwrap();
+        let eo = Region::new(&p, FillRule::EvenOdd, 0.1).unwrap();
+        assert!(nz.contains(centre) && !eo.contains(centre));
+        for tip in [Point::new(50.0, 10.0), Point::new(90.0, 37.0)] {
+            assert!(nz.contains(tip) && eo.contains(tip));
+        }
+        // The inner pentagon's area by the shoelace formula on the five
+        // crossings of the star's edges.
+        let cross = |a: (f64, f64), b: (f64, f64), c: (f64, f64), d: (f64, f64)| {
+            let (a, b, c, d) = (
+                Point::from(a),
+                Point::from(b),
+                Point::from(c),
+                Point::from(d),
+            );
+            let (r, s) = (b - a, d - c);
+            let t = (c - a).cross(s) / r.cross(s);
+            a + r * t
+        };
+        let e = |i: usize| (pts[i % 5], pts[(i + 1) % 5]);
+        let mut inner: Vec<Point> = (0..5)
+            .map(|i| {
+                let (a, b) = e(i);
+                let (c, d) = e(i + 2);
+                cross(a, b, c, d)
+            })
+            .collect();
+        // In order around the centre, so the shoelace formula applies.
+        let mid = inner.iter().fold(Vec2::ZERO, |m, p| m + p.to_vec2()) / 5.0;
+        inner.sort_by(|p, q| {
+            let (u, v) = (*p - mid.to_point(), *q - mid.to_point());
+            u.atan2().total_cmp(&v.atan2())
+        });
+        let pent = polygon_area(&inner).abs();
+        assert!(
+            (nz.area - eo.area - pent).abs() < 1e-3,
+            "{} {} {pent}",
+            nz.area,
+            eo.area
+        );
     }
 
     #[test]
