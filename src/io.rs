@@ -44,6 +44,33 @@ pub(crate) fn set_stage(what: impl Into<String>) {
     }
 }
 
+/// A stage made of `total` items done in any order (e.g. the strokes of a
+/// brush run, in parallel): the stage reads "WHAT: K of TOTAL".
+pub(crate) struct Tally {
+    what: String,
+    total: usize,
+    done: std::sync::atomic::AtomicUsize,
+}
+
+impl Tally {
+    /// Starts the stage at 0 of `total`.
+    pub(crate) fn new(what: impl Into<String>, total: usize) -> Tally {
+        let what = what.into();
+        set_stage(format!("{what}: 0 of {total}"));
+        Tally {
+            what,
+            total,
+            done: std::sync::atomic::AtomicUsize::new(0),
+        }
+    }
+
+    /// Counts one more item done.
+    pub(crate) fn tick(&self) {
+        let k = self.done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+        set_stage(format!("{}: {k} of {}", self.what, self.total));
+    }
+}
+
 /// Largest input file read, in bytes (256 MiB).
 pub const MAX_FILE_BYTES: u64 = 256 << 20;
 

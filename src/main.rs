@@ -947,14 +947,29 @@ impl Ticker {
                 s
             });
             let mut shown = String::new();
+            let mut printed = std::time::Instant::now();
+            // A log gets a line when the stage changes, and for a count
+            // that moves ("brush: strokes synthesized: K of N") a line
+            // every few seconds.
+            let label = |s: &str| s.replace(|c: char| c.is_ascii_digit(), "");
+            let every = std::time::Duration::from_secs(5);
             while !stop.load(Ordering::Relaxed) {
                 let stage = io::stage();
                 if stage != shown {
-                    match &spinner {
-                        Some(s) => s.set_message(format!("{input}: {stage}")),
-                        None => eprintln!("flourish: {input}: {stage}"),
+                    let show = match &spinner {
+                        Some(s) => {
+                            s.set_message(format!("{input}: {stage}"));
+                            true
+                        }
+                        None => label(&stage) != label(&shown) || printed.elapsed() >= every,
+                    };
+                    if show && spinner.is_none() {
+                        eprintln!("flourish: {input}: {stage}");
+                        printed = std::time::Instant::now();
                     }
-                    shown = stage;
+                    if show {
+                        shown = stage;
+                    }
                 }
                 std::thread::sleep(tick);
             }

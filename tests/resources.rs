@@ -97,7 +97,7 @@ fn a_run_that_lasts_shows_its_stage() {
     let loud = run(false);
     assert!(loud.status.success());
     let err = String::from_utf8_lossy(&loud.stderr);
-    assert!(err.contains("letter.svg: fill: 1 region"), "{err}");
+    assert!(err.contains("letter.svg: fill: "), "{err}");
     let quiet = run(true);
     assert!(quiet.status.success());
     assert!(
@@ -205,4 +205,80 @@ fn max_memory_takes_a_size_and_verbose_reports_the_peak() {
         assert_eq!(run.status.code(), Some(2), "--max-memory {bad}: {err}");
         assert_eq!(err.lines().count(), 1, "{err}");
     }
+}
+
+/// A sketch of `n` short strokes scattered over 800×600 units.
+fn strokes(n: usize) -> String {
+    let mut svg =
+        String::from(r#"<svg xmlns="http://www.w3.org/2000/svg" width="800" height="600">"#);
+    for i in 0..n {
+        let (x, y) = ((i * 37) % 780 + 10, (i * 91) % 580 + 10);
+        svg.push_str(&format!(
+            r##"<path d="M{x} {y} l12 5" fill="none" stroke="#000" stroke-width="3"/>"##
+        ));
+    }
+    svg.push_str("</svg>");
+    svg
+}
+
+#[test]
+fn a_hundred_thousand_paths_are_patterned_and_more_are_refused() {
+    let dir = folder("many-paths");
+    let src = folder("many-paths-input");
+    let many = src.join("many.svg");
+    std::fs::write(&many, strokes(100_000)).expect("a sketch");
+    let out = dir.join("many.svg");
+    let run = flourish()
+        .args(["-q", "pattern", "--style", "stipple"])
+        .arg(&many)
+        .arg("-o")
+        .arg(&out)
+        .output()
+        .expect("runs");
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let svg = std::fs::read(&out).expect("an output");
+    resvg::usvg::Tree::from_data(&svg, &resvg::usvg::Options::default()).expect("valid SVG");
+    std::fs::remove_file(&out).expect("removed");
+
+    let too_many = src.join("too-many.svg");
+    std::fs::write(&too_many, strokes(100_001)).expect("a sketch");
+    refused(
+        &dir,
+        &[
+            "pattern",
+            "--style",
+            "stipple",
+            too_many.to_str().expect("utf-8"),
+            "-o",
+            out.to_str().expect("utf-8"),
+        ],
+        "too-many.svg",
+        "more than the limit of 100000",
+    );
+}
+
+/// A brush run over many strokes counts them on stderr as it goes.
+#[test]
+fn a_long_brush_run_counts_its_strokes() {
+    let dir = folder("tally");
+    let sketch = dir.join("strokes.svg");
+    std::fs::write(&sketch, strokes(40)).expect("a sketch");
+    let cache = folder("tally-cache");
+    let run = flourish()
+        .env("FLOURISH_PROGRESS_AFTER", "0")
+        .args(["brush", "--style", "vine", "--cache"])
+        .arg(&cache)
+        .arg(&sketch)
+        .arg("-o")
+        .arg(dir.join("out.svg"))
+        .output()
+        .expect("runs");
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{err}");
+    assert!(err.contains("brush: strokes synthesized: "), "{err}");
+    assert!(err.contains(" of 40"), "{err}");
 }

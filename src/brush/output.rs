@@ -608,6 +608,7 @@ pub fn brush_sketch(style: &BrushStyle, sketch: &Sketch, opts: &Settings) -> Res
     let (spines, warnings, notes) = prepared_spines(sketch, opts)?;
     let refine = opts.refine.as_ref().map(|r| &*r.tree);
     let trace = TraceOptions::default();
+    let tally = crate::io::Tally::new("brush: strokes synthesized", spines.len());
     let done: Vec<(QueryResult, Group)> = spines
         .par_iter()
         .map(|q| {
@@ -635,6 +636,7 @@ pub fn brush_sketch(style: &BrushStyle, sketch: &Sketch, opts: &Settings) -> Res
             } else {
                 trace_query(style, &r, id, &trace)
             };
+            tally.tick();
             Ok((r, group))
         })
         .collect::<Result<Vec<_>>>()?;

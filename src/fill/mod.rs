@@ -433,7 +433,11 @@ pub fn fill_sketch<'s>(
     let mut out = Vec::new();
     let mut notes = Vec::new();
     let mut max_ppu = 1.0f64;
+    let tally = crate::io::Tally::new("fill: regions filled", regions.len());
     for (qi, (q, outline, rule)) in regions.into_iter().enumerate() {
+        if qi > 0 {
+            tally.tick();
+        }
         let (name, st) = style_of(q)?;
         let which = exemplars_of(sk, q, name, st, opts)?;
         let margin = st.params.radius + 2;

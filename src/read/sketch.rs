@@ -29,6 +29,10 @@ use std::sync::Arc;
 /// drawing's numbers (an arc of 1e308) only make them overflow.
 pub const MAX_COORD: f64 = 1e9;
 
+/// Most shapes a sketch may hand the modes (open paths and regions in
+/// all); a sketch with more is refused before any is synthesized.
+pub const MAX_QUERIES: usize = 100_000;
+
 /// Prefix of the ids given to shapes without one, so each query can be
 /// traced back to its element.
 const PRIVATE_ID: &str = "flourish-ds-";
@@ -188,6 +192,12 @@ pub fn parse(data: &[u8]) -> Result<Sketch> {
         },
     };
     walk(tree.root(), to_user, &mut read, &mut sketch);
+    if sketch.queries.len() > MAX_QUERIES {
+        return Err(Error::invalid(format!(
+            "{} shapes to decorate, more than the limit of {MAX_QUERIES}",
+            sketch.queries.len()
+        )));
+    }
     sketch.backdrop = Some(Arc::new(read.backdrop));
     sketch.text_left_out = crate::read::svg::text_left_out(data);
     Ok(sketch)
