@@ -3,7 +3,7 @@ CARGO ?= cargo
 BIN := target/release/flourish
 OUT := out
 
-.PHONY: demo test gallery golden bench lint deps clean fuzz-smoke
+.PHONY: demo test gallery golden bench lint deps clean fuzz-smoke corpus
 
 # Everything the tests need that cargo does not install: potrace, the
 # reference tracer the trace tests compare against (Debian package).
@@ -89,6 +89,21 @@ clean:
 # and the picture decoders, FUZZ_SECONDS each (default 60) from the seeds
 # in fuzz/seeds/, with a fixed libFuzzer seed. A crash stops here, its
 # input in fuzz/artifacts/.
+# A fixed sample of CORPUS_COUNT real drawings (default 200; the Debian
+# package openclipart-svg, which the target installs) through every
+# command: each run succeeds with a valid SVG or fails in one line; a
+# panic, an abort, a hang or an invalid output fails the target. The
+# table (ok / clean error / other, times, peak memory) is printed and
+# written to out/corpus/report.md.
+CORPUS_COUNT ?= 200
+OPENCLIPART = /usr/share/openclipart/svg
+corpus:
+	@[ -d $(OPENCLIPART) ] || { command -v apt-get >/dev/null && \
+	  DEBIAN_FRONTEND=noninteractive apt-get install -y -q openclipart-svg >/dev/null; } || \
+	  { echo "corpus: install the Debian package openclipart-svg"; exit 1; }
+	$(CARGO) build --release -p flourish -p flourish-tools --bin flourish --bin corpus
+	target/release/corpus --dir $(OPENCLIPART) --count $(CORPUS_COUNT) --flourish target/release/flourish --out out/corpus
+
 FUZZ_SECONDS ?= 60
 FUZZ_TARGETS = sketch_svg style_toml exemplar raster
 fuzz-smoke:

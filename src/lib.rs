@@ -150,7 +150,7 @@ pub fn fill<'a>(
         )?;
         Ok(Output {
             document: out.to_document(),
-            warnings: Vec::new(),
+            warnings: out.warnings,
             notes: out.notes,
         })
     })?;
@@ -185,7 +185,10 @@ pub fn pattern<'a>(
     io::set_stage(format!("pattern: {} shapes", sketch.queries.len()));
     let out = in_px(sketch, opts.scale, |sk| {
         let out = pattern::synthesize_sketch(sk, |q| Ok(styles.of(q)?.pattern()?.clone()), opts)?;
-        Ok(Output::new(out.to_document()))
+        Ok(Output {
+            warnings: out.warnings.clone(),
+            ..Output::new(out.to_document())
+        })
     })?;
     Ok(finish(out))
 }

@@ -282,3 +282,44 @@ fn a_long_brush_run_counts_its_strokes() {
     assert!(err.contains("brush: strokes synthesized: "), "{err}");
     assert!(err.contains(" of 40"), "{err}");
 }
+
+/// Real drawings have specks: a filled shape with nothing inside at the
+/// working resolution is left out with a warning, not the whole run.
+#[test]
+fn specks_are_left_out_of_fill_and_pattern_with_a_warning() {
+    let dir = folder("specks");
+    let sketch = dir.join("specks.svg");
+    std::fs::write(
+        &sketch,
+        r##"<svg xmlns="http://www.w3.org/2000/svg" width="300" height="300">
+<circle id="big" cx="150" cy="150" r="100" fill="#000"/>
+<circle id="speck" cx="20" cy="20" r="0.01" fill="#000"/>
+<path id="flat" d="M10 280 L200 280 L290 280 Z" fill="#000"/>
+</svg>"##,
+    )
+    .expect("a sketch");
+    for (mode, style, left_out) in [
+        ("fill", "knot", vec!["speck"]),
+        ("pattern", "stipple", vec!["speck", "flat"]),
+    ] {
+        let out = dir.join(format!("{mode}.svg"));
+        let run = flourish()
+            .args([mode, "--style", style])
+            .arg(&sketch)
+            .arg("-o")
+            .arg(&out)
+            .output()
+            .expect("runs");
+        let err = String::from_utf8_lossy(&run.stderr);
+        assert!(run.status.success(), "{mode}: {err}");
+        for id in left_out {
+            assert!(
+                err.lines()
+                    .any(|l| l.contains("warning") && l.contains(id) && l.contains("left out")),
+                "{mode}: {id}: {err}"
+            );
+        }
+        let svg = std::fs::read_to_string(&out).expect("an output");
+        assert!(svg.contains(r#"id="big""#), "{mode}: {svg}");
+    }
+}

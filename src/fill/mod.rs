@@ -326,6 +326,8 @@ pub struct FillOutput {
     pub decimals: u32,
     /// One line per thing worth telling with `--verbose`.
     pub notes: Vec<String>,
+    /// One line per region left out (too small to fill).
+    pub warnings: Vec<String>,
 }
 
 impl FillOutput {
@@ -432,6 +434,7 @@ pub fn fill_sketch<'s>(
     let mut prepared_styles: Vec<(&FillStyle, Vec<usize>, em::Prepared)> = Vec::new();
     let mut out = Vec::new();
     let mut notes = Vec::new();
+    let mut warnings = Vec::new();
     let mut max_ppu = 1.0f64;
     let tally = crate::io::Tally::new("fill: regions filled", regions.len());
     for (qi, (q, outline, rule)) in regions.into_iter().enumerate() {
@@ -460,7 +463,15 @@ pub fn fill_sketch<'s>(
         let prepared = &prepared_styles[k].2;
         let ppu = st.px_per_unit(sk);
         max_ppu = max_ppu.max(ppu);
-        let mut region = Region::rasterize(&q.id, outline, rule, ppu, margin)?;
+        let mut region = match Region::rasterize(&q.id, outline, rule, ppu, margin) {
+            Ok(r) => r,
+            // A speck (no pixel centre inside) is left out, not the run.
+            Err(Error::Degenerate { subject, reason }) => {
+                warnings.push(format!("{subject}: {reason}; it is left out"));
+                continue;
+            }
+            Err(e) => return Err(e),
+        };
         if let Flow::Fixed(d) = st.flow {
             region.direction = constant_field(region.width(), region.height(), d);
         }
@@ -529,6 +540,12 @@ pub fn fill_sketch<'s>(
             energy: syn.energy,
         });
     }
+    if out.is_empty() {
+        return Err(Error::invalid(format!(
+            "every filled shape is smaller than one tile pixel ({}); draw them larger or raise the style's resolution",
+            warnings.len()
+        )));
+    }
     Ok(FillOutput {
         width: sk.width,
         height: sk.height,
@@ -536,6 +553,7 @@ pub fn fill_sketch<'s>(
         regions: out,
         decimals: decimals_for(opts.tolerance / max_ppu),
         notes,
+        warnings,
     })
 }
 

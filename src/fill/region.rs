@@ -69,7 +69,10 @@ impl Region {
         let mask = scan_inside(w, h, &segments, fill_rule);
         let area = mask.data().iter().filter(|&&b| b).count();
         if area == 0 {
-            return Err(Error::invalid(format!("{id}: region is smaller than one tile pixel; draw it larger or raise the style's resolution")));
+            return Err(Error::degenerate(
+                id,
+                "region is smaller than one tile pixel; draw it larger or raise the style's resolution",
+            ));
         }
         let sdf = Sdf::from_segments(&mask, &segments, to_px.inverse());
         // Boundary flow, diffused over a quarter of the region's smaller side.

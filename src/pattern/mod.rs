@@ -271,6 +271,8 @@ pub struct PatternOutput {
     pub view_box: Rect,
     /// One pattern per query, in document order.
     pub queries: Vec<QueryPattern>,
+    /// One line per shape left out (nothing inside it).
+    pub warnings: Vec<String>,
 }
 
 impl PatternOutput {
@@ -311,7 +313,7 @@ pub fn synthesize_sketch(
             "no stroked path or filled shape to decorate",
         ));
     }
-    let queries = sk
+    let done = sk
         .queries
         .par_iter()
         .enumerate()
@@ -321,24 +323,44 @@ pub fn synthesize_sketch(
             let elements = match &q.kind {
                 QueryKind::Path { spine, width } => along_path(&style, spine, *width, opts, &key),
                 QueryKind::Region { outline, fill_rule } => {
-                    let region = Region::new(outline, *fill_rule, 0.05)
-                        .map_err(|r| Error::invalid(format!("{}: {r}", q.id)))?;
-                    in_region(&style, &region, outline, opts, &key)
+                    match Region::new(outline, *fill_rule, 0.05) {
+                        Ok(region) => in_region(&style, &region, outline, opts, &key),
+                        // A region with nothing inside is left out, not the run.
+                        Err(r) if r == seeds::ZERO_AREA => {
+                            return Ok(Err(format!("{}: {r}; it is left out", q.id)));
+                        }
+                        Err(r) => return Err(Error::invalid(format!("{}: {r}", q.id))),
+                    }
                 }
             }
             .map_err(|reason| Error::invalid(format!("{}: {reason}", q.id)))?;
-            Ok(QueryPattern {
+            Ok(Ok(QueryPattern {
                 id: q.id.clone(),
                 style,
                 elements,
-            })
+            }))
         })
         .collect::<Result<Vec<_>>>()?;
+    let mut queries = Vec::with_capacity(done.len());
+    let mut warnings = Vec::new();
+    for d in done {
+        match d {
+            Ok(q) => queries.push(q),
+            Err(w) => warnings.push(w),
+        }
+    }
+    if queries.is_empty() {
+        return Err(Error::invalid(format!(
+            "every shape has zero area ({})",
+            warnings.len()
+        )));
+    }
     Ok(PatternOutput {
         width: sk.width,
         height: sk.height,
         view_box: sk.view_box,
         queries,
+        warnings,
     })
 }
 

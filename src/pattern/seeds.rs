@@ -26,6 +26,9 @@ use kurbo::{BezPath, PathEl, Point, Rect, Vec2};
 use rayon::prelude::*;
 use spade::{DelaunayTriangulation, Point2, Triangulation};
 
+/// Why a region with nothing inside it is refused by [`Region::new`].
+pub const ZERO_AREA: &str = "region has zero area";
+
 /// One closed ring of a region's outline.
 #[derive(Clone, Debug)]
 pub struct Ring {
@@ -98,7 +101,7 @@ impl Region {
             (rings_pts, rule)
         };
         if rings_pts.is_empty() {
-            return Err("region has zero area".into());
+            return Err(ZERO_AREA.into());
         }
         let mut rings: Vec<Ring> = rings_pts
             .into_iter()
@@ -162,7 +165,7 @@ impl Region {
         region.area = rings.iter().map(|r| r.sign * polygon_area(&r.pos)).sum();
         region.rings = rings;
         if region.area.is_nan() || region.area < (tolerance * tolerance).max(1e-12) {
-            return Err("region has zero area".into());
+            return Err(ZERO_AREA.into());
         }
         Ok(region)
     }
