@@ -52,63 +52,62 @@ pub fn evolve(phi: &mut Grid<f32>, target: &Grid<f32>, weight: &Grid<f32>, ev: &
 pub fn step(phi: &mut Grid<f32>, target: &Grid<f32>, weight: &Grid<f32>, ev: &Evolution) {
     let (w, h) = (phi.width(), phi.height());
     let src: &Grid<f32> = phi;
-    let rows: Vec<Vec<f32>> = (0..h)
-        .into_par_iter()
-        .map(|y| {
-            (0..w)
-                .map(|x| {
-                    let c = src.get(x, y);
-                    if c.abs() >= ev.band {
-                        return c;
-                    }
-                    let at = |dx: isize, dy: isize| {
-                        let xx = (x as isize + dx).clamp(0, w as isize - 1) as usize;
-                        let yy = (y as isize + dy).clamp(0, h as isize - 1) as usize;
-                        src.get(xx, yy)
-                    };
-                    let (l, r, u, d) = (at(-1, 0), at(1, 0), at(0, -1), at(0, 1));
-                    // One-sided differences.
-                    let (dmx, dpx, dmy, dpy) = (c - l, r - c, c - u, d - c);
-                    let fs = if weight.get(x, y) > 0.0 {
-                        2.0 * (c - target.get(x, y))
-                    } else {
-                        0.0
-                    };
-                    let f = ev.lambda * fs;
-                    let grad_up = if f > 0.0 {
-                        (dmx.max(0.0).powi(2)
-                            + dpx.min(0.0).powi(2)
-                            + dmy.max(0.0).powi(2)
-                            + dpy.min(0.0).powi(2))
-                        .sqrt()
-                    } else {
-                        (dmx.min(0.0).powi(2)
-                            + dpx.max(0.0).powi(2)
-                            + dmy.min(0.0).powi(2)
-                            + dpy.max(0.0).powi(2))
-                        .sqrt()
-                    };
-                    // Curvature times |∇Φ| by central differences.
-                    let px = 0.5 * (r - l);
-                    let py = 0.5 * (d - u);
-                    let pxx = r - 2.0 * c + l;
-                    let pyy = d - 2.0 * c + u;
-                    let pxy = 0.25 * (at(1, 1) - at(1, -1) - at(-1, 1) + at(-1, -1));
-                    let g2 = px * px + py * py;
-                    let kappa_grad = if g2 > 1e-12 {
-                        (pxx * py * py - 2.0 * px * py * pxy + pyy * px * px) / g2
-                    } else {
-                        0.0
-                    };
-                    c - ev.dt * f * grad_up + ev.dt * ev.mu * kappa_grad
-                })
-                .collect()
-        })
-        .collect();
-    for (y, row) in rows.into_iter().enumerate() {
-        for (x, v) in row.into_iter().enumerate() {
-            phi.set(x, y, v);
-        }
+    let mut next = vec![0.0f32; w * h];
+    next.par_chunks_mut(w.max(1))
+        .enumerate()
+        .for_each(|(y, row)| {
+            let value = |x: usize| -> f32 {
+                let c = src.get(x, y);
+                if c.abs() >= ev.band {
+                    return c;
+                }
+                let at = |dx: isize, dy: isize| {
+                    let xx = (x as isize + dx).clamp(0, w as isize - 1) as usize;
+                    let yy = (y as isize + dy).clamp(0, h as isize - 1) as usize;
+                    src.get(xx, yy)
+                };
+                let (l, r, u, d) = (at(-1, 0), at(1, 0), at(0, -1), at(0, 1));
+                // One-sided differences.
+                let (dmx, dpx, dmy, dpy) = (c - l, r - c, c - u, d - c);
+                let fs = if weight.get(x, y) > 0.0 {
+                    2.0 * (c - target.get(x, y))
+                } else {
+                    0.0
+                };
+                let f = ev.lambda * fs;
+                let grad_up = if f > 0.0 {
+                    (dmx.max(0.0).powi(2)
+                        + dpx.min(0.0).powi(2)
+                        + dmy.max(0.0).powi(2)
+                        + dpy.min(0.0).powi(2))
+                    .sqrt()
+                } else {
+                    (dmx.min(0.0).powi(2)
+                        + dpx.max(0.0).powi(2)
+                        + dmy.min(0.0).powi(2)
+                        + dpy.max(0.0).powi(2))
+                    .sqrt()
+                };
+                // Curvature times |∇Φ| by central differences.
+                let px = 0.5 * (r - l);
+                let py = 0.5 * (d - u);
+                let pxx = r - 2.0 * c + l;
+                let pyy = d - 2.0 * c + u;
+                let pxy = 0.25 * (at(1, 1) - at(1, -1) - at(-1, 1) + at(-1, -1));
+                let g2 = px * px + py * py;
+                let kappa_grad = if g2 > 1e-12 {
+                    (pxx * py * py - 2.0 * px * py * pxy + pyy * px * px) / g2
+                } else {
+                    0.0
+                };
+                c - ev.dt * f * grad_up + ev.dt * ev.mu * kappa_grad
+            };
+            for (x, out) in row.iter_mut().enumerate() {
+                *out = value(x);
+            }
+        });
+    if let Some(g) = Grid::from_vec(w, h, next) {
+        *phi = g;
     }
 }
 

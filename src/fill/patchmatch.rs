@@ -203,6 +203,40 @@ pub fn patch_reach(r: usize) -> usize {
     (r as f64 * std::f64::consts::SQRT_2).ceil() as usize + 1
 }
 
+/// `sum` plus the squared differences between the gathered target patch
+/// `tp` (`D` channels per pixel) and the source pixels at `base + offsets`
+/// of `data`, pixel by pixel in patch order, stopping once over `bound`:
+/// [`Problem::distance`]'s loop with the depth known at compile time, so
+/// each pixel's channels are one unrolled run without bounds checks.
+#[inline]
+fn ssd<const D: usize>(
+    tp: &[f32],
+    data: &[f32],
+    base: isize,
+    offsets: &[isize],
+    mut sum: f32,
+    bound: f32,
+) -> f32 {
+    for (t, &off) in tp.chunks_exact(D).zip(offsets) {
+        let i = (base + off) as usize;
+        let (Some(sp), Ok(t)) = (
+            data.get(i..i + D)
+                .and_then(|s| <&[f32; D]>::try_from(s).ok()),
+            <&[f32; D]>::try_from(t),
+        ) else {
+            return f32::INFINITY;
+        };
+        for c in 0..D {
+            let e = sp[c] - t[c];
+            sum += e * e;
+        }
+        if sum > bound {
+            return sum;
+        }
+    }
+    sum
+}
+
 /// What a search compares: the level's [`Source`] and the target with its
 /// direction angles (radians, pixel axes).
 #[derive(Clone, Debug)]
@@ -458,18 +492,25 @@ impl<'a> Problem<'a> {
         if sum > bound {
             return sum;
         }
-        for (t, &off) in tp.chunks_exact(d).zip(offsets) {
-            let i = (base + off) as usize;
-            let sp = &src.data[i..i + d];
-            for c in 0..d {
-                let e = sp[c] - t[c];
-                sum += e * e;
-            }
-            if sum > bound {
-                return sum;
+        match d {
+            4 => ssd::<4>(tp, &src.data, base, offsets, sum, bound),
+            5 => ssd::<5>(tp, &src.data, base, offsets, sum, bound),
+            6 => ssd::<6>(tp, &src.data, base, offsets, sum, bound),
+            7 => ssd::<7>(tp, &src.data, base, offsets, sum, bound),
+            _ => {
+                for (t, &off) in tp.chunks_exact(d).zip(offsets) {
+                    let i = (base + off) as usize;
+                    for (a, b) in src.data[i..i + d].iter().zip(t) {
+                        let e = a - b;
+                        sum += e * e;
+                    }
+                    if sum > bound {
+                        return sum;
+                    }
+                }
+                sum
             }
         }
-        sum
     }
 
     /// Recomputes every match's cost against the current target.
