@@ -626,6 +626,11 @@ fn colour_key(c: &[f32; 3]) -> u32 {
     ((c[0] as u32 >> 4) << 8) | ((c[1] as u32 >> 4) << 4) | (c[2] as u32 >> 4)
 }
 
+/// [`colour_key`] of an opaque pixel's colour, from its bytes.
+fn byte_key(p: &[u8; 4]) -> u16 {
+    (u16::from(p[0] >> 4) << 8) | (u16::from(p[1] >> 4) << 4) | u16::from(p[2] >> 4)
+}
+
 impl Palette {
     /// The palette of `w` × `h` RGBA pixels (see [`quantized_layers`]):
     /// colours that fill patches of their own, most common first, at
@@ -633,7 +638,13 @@ impl Palette {
     /// only the paper with `paper_only`.
     fn of(px: &[[u8; 4]], w: usize, h: usize, has_alpha: bool, paper_only: bool) -> Palette {
         let rgb = |p: &[u8; 4]| composite(p, has_alpha);
-        let keys: Vec<u16> = px.par_iter().map(|p| colour_key(&rgb(p)) as u16).collect();
+        // An opaque pixel's key is read off its bytes (its composite is
+        // the bytes themselves).
+        let keys: Vec<u16> = if has_alpha {
+            px.par_iter().map(|p| colour_key(&rgb(p)) as u16).collect()
+        } else {
+            px.par_iter().map(byte_key).collect()
+        };
         // Per colour bin: pixels, pixels inside a patch of the colour (their
         // four neighbours in the same bin), and the sum of the colours.
         // (Keys are 12 bits: one slot per key, visited in key order.) Bands
@@ -824,7 +835,10 @@ impl Palette {
 /// An RGBA pixel composited over white (transparency reads as paper),
 /// RGB 0..=255.
 fn composite(p: &[u8; 4], has_alpha: bool) -> [f32; 3] {
-    let a = if has_alpha { p[3] as f32 / 255.0 } else { 1.0 };
+    if !has_alpha {
+        return [f32::from(p[0]), f32::from(p[1]), f32::from(p[2])];
+    }
+    let a = p[3] as f32 / 255.0;
     [0, 1, 2].map(|k| p[k] as f32 * a + 255.0 * (1.0 - a))
 }
 
@@ -941,6 +955,24 @@ fn quantized_layers(
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    /// An opaque pixel's colour and key read off its bytes are the
+    /// composite's, for every level of each channel.
+    #[test]
+    fn opaque_pixels_key_by_their_bytes() {
+        for v in 0..=255u8 {
+            for p in [
+                [v, 0, 0, 255],
+                [0, v, 0, 255],
+                [0, 0, v, 255],
+                [v, 255 - v, v / 3, 255],
+            ] {
+                let slow = [0, 1, 2].map(|k| p[k] as f32 * 1.0 + 255.0 * (1.0 - 1.0));
+                assert_eq!(composite(&p, false), slow);
+                assert_eq!(u32::from(byte_key(&p)), colour_key(&slow));
+            }
+        }
+    }
 
     /// The grey path as first written: a coverage grid (darkness on the
     /// image's [`InkScale`], as the colour path measures it), checked for
