@@ -545,42 +545,85 @@ fn one_ink(px: &[[u8; 4]], raw: &[f32], scale: InkScale) -> bool {
         return true;
     }
     let rgb = |p: &[u8; 4]| [p[0], p[1], p[2]].map(|v| v as f32 / 255.0);
-    let mean = |near: f32| {
-        let (sum, n) = px
+    // The mean colours of the pixels at the paper's and at the ink's
+    // level, summed over fixed chunks in parallel and the chunks added in
+    // order. (Each channel is a multiple of 2⁻³¹ under 1, so in f64 the
+    // sums of up to 4 M pixels are exact in any order.)
+    type Sums = ([f64; 3], u64);
+    let add = |(mut s, n): Sums, p: &[u8; 4]| {
+        for (a, b) in s.iter_mut().zip(rgb(p)) {
+            *a += f64::from(b);
+        }
+        (s, n + 1)
+    };
+    let near = |c: f32, level: f32| (c - level).abs() <= 1.0 / 255.0;
+    let chunks: Vec<(Sums, Sums)> = px
+        .par_chunks(ONE_INK_CHUNK)
+        .zip(raw.par_chunks(ONE_INK_CHUNK))
+        .map(|(ps, cs)| {
+            ps.iter().zip(cs).fold(
+                (([0f64; 3], 0u64), ([0f64; 3], 0u64)),
+                |(paper, ink), (p, &c)| {
+                    (
+                        if near(c, scale.paper) {
+                            add(paper, p)
+                        } else {
+                            paper
+                        },
+                        if near(c, scale.ink) { add(ink, p) } else { ink },
+                    )
+                },
+            )
+        })
+        .collect();
+    let total = |pick: fn(&(Sums, Sums)) -> &Sums| {
+        let (sum, n) = chunks
             .iter()
-            .zip(raw)
-            .filter(|(_, &c)| (c - near).abs() <= 1.0 / 255.0)
-            .fold(([0f64; 3], 0u64), |(mut s, n), (p, _)| {
-                for (a, b) in s.iter_mut().zip(rgb(p)) {
-                    *a += f64::from(b);
+            .map(pick)
+            .fold(([0f64; 3], 0u64), |(mut s, n), (t, m)| {
+                for (a, b) in s.iter_mut().zip(t) {
+                    *a += b;
                 }
-                (s, n + 1)
+                (s, n + m)
             });
         sum.map(|v| (v / n.max(1) as f64) as f32)
     };
-    let (paper, ink) = (mean(scale.paper), mean(scale.ink));
+    let (paper, ink) = (total(|c| &c.0), total(|c| &c.1));
     let d: [f32; 3] = std::array::from_fn(|k| ink[k] - paper[k]);
     let len2: f32 = d.iter().map(|v| v * v).sum();
-    let (mut inked, mut off) = (0u64, 0u64);
-    for (p, &c) in px.iter().zip(raw) {
-        if c < scale.paper + PAPER_NOISE {
-            continue;
-        }
-        inked += 1;
-        let q = rgb(p);
-        let v: [f32; 3] = std::array::from_fn(|k| q[k] - paper[k]);
-        let t = if len2 > 0.0 {
-            (v.iter().zip(&d).map(|(a, b)| a * b).sum::<f32>() / len2).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        let dist2: f32 = v.iter().zip(&d).map(|(a, b)| (a - t * b).powi(2)).sum();
-        if dist2 > MIX_TOLERANCE * MIX_TOLERANCE {
-            off += 1;
-        }
-    }
+    // Inked pixels, and those off the paper–ink segment (integer counts,
+    // so in any order).
+    let (inked, off) = px
+        .par_chunks(ONE_INK_CHUNK)
+        .zip(raw.par_chunks(ONE_INK_CHUNK))
+        .map(|(ps, cs)| {
+            let (mut inked, mut off) = (0u64, 0u64);
+            for (p, &c) in ps.iter().zip(cs) {
+                if c < scale.paper + PAPER_NOISE {
+                    continue;
+                }
+                inked += 1;
+                let q = rgb(p);
+                let v: [f32; 3] = std::array::from_fn(|k| q[k] - paper[k]);
+                let t = if len2 > 0.0 {
+                    (v.iter().zip(&d).map(|(a, b)| a * b).sum::<f32>() / len2).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                let dist2: f32 = v.iter().zip(&d).map(|(a, b)| (a - t * b).powi(2)).sum();
+                if dist2 > MIX_TOLERANCE * MIX_TOLERANCE {
+                    off += 1;
+                }
+            }
+            (inked, off)
+        })
+        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
     off * 10 <= inked
 }
+
+/// Pixels per chunk of [`one_ink`]'s parallel passes (fixed, so its sums
+/// do not depend on the thread count).
+const ONE_INK_CHUNK: usize = 1 << 16;
 
 fn luma(p: &[u8; 4]) -> f32 {
     (0.2126 * p[0] as f32 + 0.7152 * p[1] as f32 + 0.0722 * p[2] as f32) / 255.0
