@@ -72,9 +72,11 @@ golden:
 	UPDATE_GOLDEN=1 $(CARGO) test --test golden
 	git status --short golden/
 
-# Criterion benchmarks of every pipeline, then the side-by-side with potrace.
+# Criterion benchmarks of every pipeline, then the side-by-side with potrace
+# (whole commands, the release binary against potrace, pairwise).
 bench: deps
 	$(CARGO) bench
+	$(CARGO) build --release
 	$(CARGO) run --release -p flourish-tools --bin compare_potrace
 
 lint:

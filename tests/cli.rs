@@ -406,6 +406,17 @@ fn huge_declared_png_fails_fast_with_size_limit() {
     trace_must_fail(&p, &["size limit"]);
 }
 
+/// A 100-megapixel picture (10,000 px square, issue 24's size case) is
+/// refused before it is decoded: one line naming the file and the size
+/// limit, exit 1, no output.
+#[test]
+fn hundred_megapixel_png_is_refused_with_the_size_limit() {
+    let t = tempdir();
+    let p = t.path().join("photo-100mpx.png");
+    std::fs::write(&p, png_header_only(10_000, 10_000)).unwrap();
+    trace_must_fail(&p, &["size limit", "10000×10000"]);
+}
+
 #[test]
 fn huge_declared_svg_canvas_is_capped_by_resolution() {
     // A huge SVG is rasterized at --resolution, so it is not a size error;

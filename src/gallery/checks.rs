@@ -22,7 +22,12 @@
 //!   (IoU of the ink at the bitmap's size); a drawing in several colours,
 //!   traced `--layers --cutout` too and rendered at 4× without
 //!   anti-aliasing, leaves no pixel uncovered (`cutout-gaps`) and none
-//!   covered twice (`cutout-overlaps`).
+//!   covered twice (`cutout-overlaps`), and no colour's IoU with the
+//!   drawing's is lower than stacked mode's (`cutout-iou`, the worst
+//!   difference); the default trace (every ink in
+//!   one layer) makes at most 0.8× the segments potrace makes of the
+//!   bitmap thresholded at one half (`segments-vs-potrace`, `potrace -s -t
+//!   3`, issue 24).
 
 use crate::brush::measure::{ink, ExemplarFigures, Fidelity};
 use crate::brush::output::{brush_sketch, out_per_fine};
@@ -710,6 +715,62 @@ fn tolerant_f(a: &[bool], b: &[bool], w: usize) -> f64 {
     }
 }
 
+/// The segments (lines and curves) potrace's SVG backend (`potrace -s`)
+/// makes of the bitmap `input`, read as potrace reads a picture turned
+/// into a PBM: ink where the luminance is under one half; speck size 3
+/// (`-t 3`, what flourish's default `--min-area 4` drops). `None` when the
+/// bitmap cannot be read or potrace does not run.
+fn potrace_segments(input: &Path) -> Option<usize> {
+    let grey = image::open(input).ok()?.to_luma8();
+    let (w, h) = (grey.width() as usize, grey.height() as usize);
+    let stride = w.div_ceil(8);
+    let mut pbm = format!("P4\n{w} {h}\n").into_bytes();
+    for row in grey.as_raw().chunks_exact(w.max(1)) {
+        let mut bits = vec![0u8; stride];
+        for (x, &v) in row.iter().enumerate() {
+            if v < 128 {
+                bits[x / 8] |= 0x80 >> (x % 8);
+            }
+        }
+        pbm.extend_from_slice(&bits);
+    }
+    let dir = tempfile::tempdir().ok()?;
+    let (inp, out) = (dir.path().join("in.pbm"), dir.path().join("out.svg"));
+    std::fs::write(&inp, pbm).ok()?;
+    let ran = std::process::Command::new("potrace")
+        .args(["-s", "-t", "3", "-o"])
+        .arg(&out)
+        .arg(&inp)
+        .status()
+        .ok()?;
+    if !ran.success() {
+        return None;
+    }
+    let svg = std::fs::read(&out).ok()?;
+    let tree = resvg::usvg::Tree::from_data(&svg, &resvg::usvg::Options::default()).ok()?;
+    fn count(g: &resvg::usvg::Group) -> usize {
+        g.children()
+            .iter()
+            .map(|n| match n {
+                resvg::usvg::Node::Group(g) => count(g),
+                resvg::usvg::Node::Path(p) => p
+                    .data()
+                    .segments()
+                    .filter(|s| {
+                        !matches!(
+                            s,
+                            resvg::tiny_skia::PathSegment::MoveTo(_)
+                                | resvg::tiny_skia::PathSegment::Close
+                        )
+                    })
+                    .count(),
+                _ => 0,
+            })
+            .sum()
+    }
+    Some(count(tree.root()))
+}
+
 fn trace(input: &Path) -> Outcome {
     let bytes = crate::io::read_file(input)?;
     let truth = std::fs::read_to_string(input.with_extension("svg"))
@@ -749,6 +810,26 @@ fn trace(input: &Path) -> Outcome {
             wanted: "(recorded: the scan is turned)".into(),
         }
     });
+    // Segments against potrace's on the same bitmap: flourish's default
+    // trace (one layer of every ink, as the issue compares them).
+    let own = if read.layers {
+        let one = crate::Image::from_bytes(&bytes, &crate::ImageOptions::default())?;
+        crate::trace(&one, &crate::TraceOptions::default())?
+            .document
+            .segment_count() as f64
+    } else {
+        segments
+    };
+    checks.push(match potrace_segments(input) {
+        Some(p) => Check::at_most("segments-vs-potrace", own / p.max(1) as f64, 0.8),
+        None => Check {
+            name: "segments-vs-potrace".into(),
+            value: None,
+            ok: false,
+            higher_is_better: false,
+            wanted: "potrace installed (make deps)".into(),
+        },
+    });
     if read.layers {
         // The same colours cut out: rendered at 4x without anti-aliasing,
         // no pixel left uncovered and none covered twice.
@@ -757,6 +838,24 @@ fn trace(input: &Path) -> Outcome {
         let (gaps, overlaps) = crate::trace::cutout::measure::gaps_and_overlaps(&cut.document, 4.0);
         checks.push(Check::at_most("cutout-gaps", gaps as f64, 0.0));
         checks.push(Check::at_most("cutout-overlaps", overlaps as f64, 0.0));
+        // Each colour's IoU with the drawing's (pixels nearest the colour,
+        // both rendered at the bitmap's size) cut out against stacked: the
+        // worst difference.
+        let palette: Vec<crate::svg_out::Color> = cut
+            .document
+            .groups
+            .iter()
+            .filter_map(|g| g.shapes.first().and_then(|s| s.fill))
+            .collect();
+        let cut_ious =
+            crate::trace::cutout::measure::colour_ious(&cut.to_svg(), &truth, &palette, w, h);
+        let stacked_ious = crate::trace::cutout::measure::colour_ious(&svg, &truth, &palette, w, h);
+        let worst = cut_ious
+            .iter()
+            .zip(&stacked_ious)
+            .map(|(c, s)| c - s)
+            .fold(f64::INFINITY, f64::min);
+        checks.push(Check::at_least("cutout-iou", worst, 0.0));
     }
     Ok((svg, checks))
 }

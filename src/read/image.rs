@@ -545,42 +545,85 @@ fn one_ink(px: &[[u8; 4]], raw: &[f32], scale: InkScale) -> bool {
         return true;
     }
     let rgb = |p: &[u8; 4]| [p[0], p[1], p[2]].map(|v| v as f32 / 255.0);
-    let mean = |near: f32| {
-        let (sum, n) = px
+    // The mean colours of the pixels at the paper's and at the ink's
+    // level, summed over fixed chunks in parallel and the chunks added in
+    // order. (Each channel is a multiple of 2⁻³¹ under 1, so in f64 the
+    // sums of up to 4 M pixels are exact in any order.)
+    type Sums = ([f64; 3], u64);
+    let add = |(mut s, n): Sums, p: &[u8; 4]| {
+        for (a, b) in s.iter_mut().zip(rgb(p)) {
+            *a += f64::from(b);
+        }
+        (s, n + 1)
+    };
+    let near = |c: f32, level: f32| (c - level).abs() <= 1.0 / 255.0;
+    let chunks: Vec<(Sums, Sums)> = px
+        .par_chunks(ONE_INK_CHUNK)
+        .zip(raw.par_chunks(ONE_INK_CHUNK))
+        .map(|(ps, cs)| {
+            ps.iter().zip(cs).fold(
+                (([0f64; 3], 0u64), ([0f64; 3], 0u64)),
+                |(paper, ink), (p, &c)| {
+                    (
+                        if near(c, scale.paper) {
+                            add(paper, p)
+                        } else {
+                            paper
+                        },
+                        if near(c, scale.ink) { add(ink, p) } else { ink },
+                    )
+                },
+            )
+        })
+        .collect();
+    let total = |pick: fn(&(Sums, Sums)) -> &Sums| {
+        let (sum, n) = chunks
             .iter()
-            .zip(raw)
-            .filter(|(_, &c)| (c - near).abs() <= 1.0 / 255.0)
-            .fold(([0f64; 3], 0u64), |(mut s, n), (p, _)| {
-                for (a, b) in s.iter_mut().zip(rgb(p)) {
-                    *a += f64::from(b);
+            .map(pick)
+            .fold(([0f64; 3], 0u64), |(mut s, n), (t, m)| {
+                for (a, b) in s.iter_mut().zip(t) {
+                    *a += b;
                 }
-                (s, n + 1)
+                (s, n + m)
             });
         sum.map(|v| (v / n.max(1) as f64) as f32)
     };
-    let (paper, ink) = (mean(scale.paper), mean(scale.ink));
+    let (paper, ink) = (total(|c| &c.0), total(|c| &c.1));
     let d: [f32; 3] = std::array::from_fn(|k| ink[k] - paper[k]);
     let len2: f32 = d.iter().map(|v| v * v).sum();
-    let (mut inked, mut off) = (0u64, 0u64);
-    for (p, &c) in px.iter().zip(raw) {
-        if c < scale.paper + PAPER_NOISE {
-            continue;
-        }
-        inked += 1;
-        let q = rgb(p);
-        let v: [f32; 3] = std::array::from_fn(|k| q[k] - paper[k]);
-        let t = if len2 > 0.0 {
-            (v.iter().zip(&d).map(|(a, b)| a * b).sum::<f32>() / len2).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        let dist2: f32 = v.iter().zip(&d).map(|(a, b)| (a - t * b).powi(2)).sum();
-        if dist2 > MIX_TOLERANCE * MIX_TOLERANCE {
-            off += 1;
-        }
-    }
+    // Inked pixels, and those off the paper–ink segment (integer counts,
+    // so in any order).
+    let (inked, off) = px
+        .par_chunks(ONE_INK_CHUNK)
+        .zip(raw.par_chunks(ONE_INK_CHUNK))
+        .map(|(ps, cs)| {
+            let (mut inked, mut off) = (0u64, 0u64);
+            for (p, &c) in ps.iter().zip(cs) {
+                if c < scale.paper + PAPER_NOISE {
+                    continue;
+                }
+                inked += 1;
+                let q = rgb(p);
+                let v: [f32; 3] = std::array::from_fn(|k| q[k] - paper[k]);
+                let t = if len2 > 0.0 {
+                    (v.iter().zip(&d).map(|(a, b)| a * b).sum::<f32>() / len2).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                let dist2: f32 = v.iter().zip(&d).map(|(a, b)| (a - t * b).powi(2)).sum();
+                if dist2 > MIX_TOLERANCE * MIX_TOLERANCE {
+                    off += 1;
+                }
+            }
+            (inked, off)
+        })
+        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
     off * 10 <= inked
 }
+
+/// Pixels per chunk of [`one_ink`]'s parallel passes (fixed, so its sums
+/// do not depend on the thread count).
+const ONE_INK_CHUNK: usize = 1 << 16;
 
 fn luma(p: &[u8; 4]) -> f32 {
     (0.2126 * p[0] as f32 + 0.7152 * p[1] as f32 + 0.0722 * p[2] as f32) / 255.0
@@ -626,6 +669,11 @@ fn colour_key(c: &[f32; 3]) -> u32 {
     ((c[0] as u32 >> 4) << 8) | ((c[1] as u32 >> 4) << 4) | (c[2] as u32 >> 4)
 }
 
+/// [`colour_key`] of an opaque pixel's colour, from its bytes.
+fn byte_key(p: &[u8; 4]) -> u16 {
+    (u16::from(p[0] >> 4) << 8) | (u16::from(p[1] >> 4) << 4) | u16::from(p[2] >> 4)
+}
+
 impl Palette {
     /// The palette of `w` × `h` RGBA pixels (see [`quantized_layers`]):
     /// colours that fill patches of their own, most common first, at
@@ -633,7 +681,13 @@ impl Palette {
     /// only the paper with `paper_only`.
     fn of(px: &[[u8; 4]], w: usize, h: usize, has_alpha: bool, paper_only: bool) -> Palette {
         let rgb = |p: &[u8; 4]| composite(p, has_alpha);
-        let keys: Vec<u16> = px.par_iter().map(|p| colour_key(&rgb(p)) as u16).collect();
+        // An opaque pixel's key is read off its bytes (its composite is
+        // the bytes themselves).
+        let keys: Vec<u16> = if has_alpha {
+            px.par_iter().map(|p| colour_key(&rgb(p)) as u16).collect()
+        } else {
+            px.par_iter().map(byte_key).collect()
+        };
         // Per colour bin: pixels, pixels inside a patch of the colour (their
         // four neighbours in the same bin), and the sum of the colours.
         // (Keys are 12 bits: one slot per key, visited in key order.) Bands
@@ -824,7 +878,10 @@ impl Palette {
 /// An RGBA pixel composited over white (transparency reads as paper),
 /// RGB 0..=255.
 fn composite(p: &[u8; 4], has_alpha: bool) -> [f32; 3] {
-    let a = if has_alpha { p[3] as f32 / 255.0 } else { 1.0 };
+    if !has_alpha {
+        return [f32::from(p[0]), f32::from(p[1]), f32::from(p[2])];
+    }
+    let a = p[3] as f32 / 255.0;
     [0, 1, 2].map(|k| p[k] as f32 * a + 255.0 * (1.0 - a))
 }
 
@@ -941,6 +998,24 @@ fn quantized_layers(
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    /// An opaque pixel's colour and key read off its bytes are the
+    /// composite's, for every level of each channel.
+    #[test]
+    fn opaque_pixels_key_by_their_bytes() {
+        for v in 0..=255u8 {
+            for p in [
+                [v, 0, 0, 255],
+                [0, v, 0, 255],
+                [0, 0, v, 255],
+                [v, 255 - v, v / 3, 255],
+            ] {
+                let slow = [0, 1, 2].map(|k| p[k] as f32 * 1.0 + 255.0 * (1.0 - 1.0));
+                assert_eq!(composite(&p, false), slow);
+                assert_eq!(u32::from(byte_key(&p)), colour_key(&slow));
+            }
+        }
+    }
 
     /// The grey path as first written: a coverage grid (darkness on the
     /// image's [`InkScale`], as the colour path measures it), checked for

@@ -168,20 +168,28 @@ impl Lighting {
         (self.brightest / paper) as f32
     }
 
-    /// The gains of row `y` (see `Lighting::gain`), pixel by pixel: the
-    /// surface along a row is a cubic in `u` whose coefficients are read
-    /// off the two-variable one once per row and evaluated by Horner's
-    /// rule (the same polynomial, to rounding).
-    fn row_gains(&self, y: usize) -> impl Iterator<Item = f32> + '_ {
+    /// Each column's `u` coordinate (−1..=1 across the picture, at the
+    /// pixel's centre), worked out once for all rows.
+    fn columns(&self) -> Vec<f64> {
+        let w = self.width as f64;
+        (0..self.width)
+            .map(|x| 2.0 * (x as f64 + 0.5) / w - 1.0)
+            .collect()
+    }
+
+    /// The gains of row `y` (see `Lighting::gain`), pixel by pixel, at the
+    /// columns' coordinates `us` ([`Lighting::columns`]): the surface
+    /// along a row is a cubic in `u` whose coefficients are read off the
+    /// two-variable one once per row and evaluated by Horner's rule (the
+    /// same polynomial, to rounding).
+    fn row_gains<'a>(&'a self, y: usize, us: &'a [f64]) -> impl Iterator<Item = f32> + 'a {
         let v = 2.0 * (y as f64 + 0.5) / self.height as f64 - 1.0;
         let c = &self.coef;
         let a0 = c[0] + v * (c[2] + v * (c[5] + v * c[9]));
         let a1 = c[1] + v * (c[4] + v * c[8]);
         let a2 = c[3] + v * c[7];
         let a3 = c[6];
-        let w = self.width as f64;
-        (0..self.width).map(move |x| {
-            let u = 2.0 * (x as f64 + 0.5) / w - 1.0;
+        us.iter().map(move |&u| {
             let paper = (a0 + u * (a1 + u * (a2 + u * a3))).max(self.darkest);
             (self.brightest / paper) as f32
         })
@@ -190,8 +198,9 @@ impl Lighting {
     /// Evens out the light of grey pixels (0..=255, row by row) in place.
     pub fn flatten_grey(&self, grey: &mut [u8]) {
         let w = self.width.max(1);
+        let us = self.columns();
         grey.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-            for (v, g) in row.iter_mut().zip(self.row_gains(y)) {
+            for (v, g) in row.iter_mut().zip(self.row_gains(y, &us)) {
                 *v = scaled(*v, g);
             }
         });
@@ -201,8 +210,9 @@ impl Lighting {
     /// colour channel times the same gain, so hues stay.
     pub fn flatten_rgba(&self, px: &mut [[u8; 4]]) {
         let w = self.width.max(1);
+        let us = self.columns();
         px.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-            for (p, g) in row.iter_mut().zip(self.row_gains(y)) {
+            for (p, g) in row.iter_mut().zip(self.row_gains(y, &us)) {
                 for c in &mut p[..3] {
                     *c = scaled(*c, g);
                 }
@@ -211,9 +221,13 @@ impl Lighting {
     }
 }
 
-/// `v` times `gain`, rounded and held to 0..=255.
+/// `v` times `gain` (positive), rounded half up and held to 0..=255: the
+/// whole part taken once as an integer and one added when the fraction
+/// is at least a half (what [`crate::raster::round_positive`] gives).
 fn scaled(v: u8, gain: f32) -> u8 {
-    crate::raster::round_positive((f32::from(v) * gain).clamp(0.0, 255.0)) as u8
+    let x = (f32::from(v) * gain).clamp(0.0, 255.0);
+    let whole = x as u32;
+    (whole + u32::from(x - whole as f32 >= 0.5)).min(255) as u8
 }
 
 /// The surface `coef` at terms `t`.
@@ -376,11 +390,37 @@ mod tests {
         let img = photo(w, h, light);
         let l = Lighting::measure(w, h, at(&img, w)).expect("uneven");
         for y in 0..h {
-            for (x, g) in l.row_gains(y).enumerate() {
+            for (x, g) in l.row_gains(y, &l.columns()).enumerate() {
                 let want = l.gain(x, y);
                 assert!((g - want).abs() <= 1e-6 * want, "({x}, {y}): {g} vs {want}");
             }
-            assert_eq!(l.row_gains(y).count(), w);
+            assert_eq!(l.row_gains(y, &l.columns()).count(), w);
+        }
+    }
+
+    /// The scaled value is `round_positive` of the clamped product, for
+    /// every byte, at gains putting the product on a half and one ulp
+    /// either side of it, and at a few plain gains.
+    #[test]
+    fn scaled_rounds_as_round_positive() {
+        let check = |v: u8, g: f32| {
+            let want = crate::raster::round_positive((f32::from(v) * g).clamp(0.0, 255.0)) as u8;
+            assert_eq!(scaled(v, g), want, "{v} × {g}");
+        };
+        for v in 0..=255u8 {
+            for g in [0.3f32, 0.5, 1.0, 1.0 / 3.0, 1.25, 1.5, 7.9] {
+                check(v, g);
+            }
+            for t in 0..=255u32 {
+                let g = (t as f32 + 0.5) / f32::from(v.max(1));
+                for g in [
+                    g,
+                    f32::from_bits(g.to_bits() - 1),
+                    f32::from_bits(g.to_bits() + 1),
+                ] {
+                    check(v, g);
+                }
+            }
         }
     }
 

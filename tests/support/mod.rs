@@ -32,9 +32,16 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-/// The crate root.
+/// The crate root (the folder holding `samples/`: the manifest's own for
+/// the tests, its parent for the `tools/` programs that include this file).
 pub fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    match dir.parent() {
+        Some(up) if !dir.join("samples").is_dir() && up.join("samples").is_dir() => {
+            up.to_path_buf()
+        }
+        _ => dir,
+    }
 }
 
 /// `samples/trace/NAME`.
@@ -793,6 +800,165 @@ pub struct Comparison {
     /// 50 %-thresholded input bitmap.
     pub flourish_iou: f64,
     pub potrace_iou: f64,
+}
+
+/// The `flourish` binary the whole-command timing runs:
+/// `$FLOURISH_BIN`, else the release build in `target/release`.
+pub fn flourish_bin() -> PathBuf {
+    std::env::var_os("FLOURISH_BIN")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root().join("target/release/flourish"))
+}
+
+/// Whole commands timed against each other on one bitmap.
+#[derive(Clone, Copy, Debug)]
+pub struct CommandTimes {
+    /// Median wall-clock time of `flourish trace PNG -o SVG` (decoding,
+    /// tracing and writing, the process's start included).
+    pub flourish: Duration,
+    /// Median wall-clock time of `potrace -s -t N PBM -o SVG`.
+    pub potrace: Duration,
+    /// Median over the pairs of flourish's time over potrace's.
+    pub ratio: f64,
+}
+
+/// Times the whole `flourish trace` command on `png` (the binary at
+/// [`flourish_bin`], default options) against the whole `potrace -s`
+/// command on the same bitmap thresholded at 50 % (written as PBM once,
+/// outside the timing; speck size [`potrace_turdsize`]): after one untimed
+/// run of each, `runs` pairs run back to back, flourish first in even
+/// pairs and potrace first in odd ones, so a change of load on a shared
+/// machine falls on both; the ratio is the median of the pairs' ratios.
+pub fn time_commands(png: &Path, bitmap: &image::GrayImage, runs: usize) -> CommandTimes {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let pbm = dir.path().join("in.pbm");
+    let (fsvg, psvg) = (dir.path().join("f.svg"), dir.path().join("p.svg"));
+    std::fs::write(&pbm, pbm_bytes(bitmap)).expect("write PBM");
+    let bin = flourish_bin();
+    let flourish = || {
+        let t = Instant::now();
+        let st = Command::new(&bin)
+            .arg("trace")
+            .arg(png)
+            .arg("-o")
+            .arg(&fsvg)
+            .arg("-q")
+            .status()
+            .expect("run flourish");
+        let e = t.elapsed();
+        assert!(
+            st.success(),
+            "flourish trace {} failed: {st}",
+            png.display()
+        );
+        e
+    };
+    let potrace = || {
+        let t = Instant::now();
+        let st = Command::new("potrace")
+            .arg("-s")
+            .arg("-t")
+            .arg(potrace_turdsize().to_string())
+            .arg("-o")
+            .arg(&psvg)
+            .arg(&pbm)
+            .status()
+            .expect("run potrace");
+        let e = t.elapsed();
+        assert!(st.success(), "potrace failed: {st}");
+        e
+    };
+    flourish();
+    potrace();
+    let (mut ft, mut pt, mut ratios) = (Vec::new(), Vec::new(), Vec::new());
+    for k in 0..runs.max(1) {
+        let (f, p) = if k % 2 == 0 {
+            let f = flourish();
+            (f, potrace())
+        } else {
+            let p = potrace();
+            (flourish(), p)
+        };
+        ratios.push(f.as_secs_f64() / p.as_secs_f64().max(1e-6));
+        ft.push(f);
+        pt.push(p);
+    }
+    ratios.sort_by(f64::total_cmp);
+    CommandTimes {
+        flourish: median(ft),
+        potrace: median(pt),
+        ratio: ratios[ratios.len() / 2],
+    }
+}
+
+/// Everything measured for one bitmap by [`compare_file`].
+#[derive(Clone, Debug)]
+pub struct FileComparison {
+    /// The bitmap's file name.
+    pub name: String,
+    pub width: u32,
+    pub height: u32,
+    pub flourish_segments: usize,
+    pub potrace_segments: usize,
+    /// Symmetric Hausdorff distances (px) to the ground truth, when the
+    /// truth lines up with the bitmap (not on a scan turned by hand).
+    pub flourish_dev: Option<f64>,
+    pub potrace_dev: Option<f64>,
+    /// The whole commands timed against each other.
+    pub times: CommandTimes,
+    /// IoU of each tracer's output, rendered and thresholded, with the
+    /// 50 %-thresholded input bitmap.
+    pub flourish_iou: f64,
+    pub potrace_iou: f64,
+}
+
+/// Runs both tracers on the bitmap `png` (a sample, or third-party art
+/// whose ground truth `NAME.svg` is drawn at a uniform scale of the
+/// bitmap) and measures them; the ground-truth distances only where the
+/// truth, scaled to the bitmap, lines up with it (not `*-scanned*`,
+/// turned by hand) and `deviation` asks for them (the truth of large art
+/// takes long to extract).
+pub fn compare_file(png: &Path, runs: usize, deviation: bool) -> FileComparison {
+    let bitmap = image::open(png).expect("bitmap").to_luma8();
+    let (w, h) = bitmap.dimensions();
+    let name = png
+        .file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_default();
+    let (doc, _) = run_flourish(png, 1);
+    let fpaths = doc_paths(&doc);
+    let (ppaths, psegs, _) = run_potrace(&bitmap, 1);
+    let svg = truth_svg_for(png);
+    let aligned = deviation && svg.exists() && !name.contains("scanned");
+    let (fdev, pdev) = if aligned {
+        let (sw, sh) = svg_size(&svg);
+        let s = w as f64 / sw;
+        assert!(
+            (sh * s - h as f64).abs() < 1.0,
+            "{name}: the truth ({sw}×{sh}) is not the bitmap ({w}×{h}) scaled"
+        );
+        let truth: Vec<Line> = ground_truth(&svg)
+            .into_iter()
+            .map(|l| Line::new((l.p0.x * s, l.p0.y * s), (l.p1.x * s, l.p1.y * s)))
+            .collect();
+        let (f, p) = (deviations(&fpaths, &truth), deviations(&ppaths, &truth));
+        (Some(f.0.max(f.1)), Some(p.0.max(p.1)))
+    } else {
+        (None, None)
+    };
+    let mask = ink_mask(&bitmap);
+    FileComparison {
+        name,
+        width: w,
+        height: h,
+        flourish_segments: doc.segment_count(),
+        potrace_segments: psegs,
+        flourish_dev: fdev,
+        potrace_dev: pdev,
+        times: time_commands(png, &bitmap, runs),
+        flourish_iou: iou(&rasterize(&fpaths, w, h), &mask),
+        potrace_iou: iou(&rasterize(&ppaths, w, h), &mask),
+    }
 }
 
 /// Runs both tracers on `samples/trace/NAME` and measures them.

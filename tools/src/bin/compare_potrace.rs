@@ -1,20 +1,30 @@
 //! Prints a markdown table comparing `flourish trace` (default options) with
 //! potrace (`potrace -s`, default options but for the speck size, set to
 //! drop what flourish drops: `-t 3` against `--min-area 4`; on the 50
-//! %-thresholded bitmap) on every sample in `samples/trace`: segments, max deviation from the
-//! vector ground truth (symmetric Hausdorff, px) and median time of 5 runs.
+//! %-thresholded bitmap) on every sample in `samples/trace` and every
+//! bitmap of the third-party art's `trace/` folder (`$FLOURISH_ART`, else
+//! `../shared/art`) when it is there: segments, max deviation from the
+//! vector ground truth (symmetric Hausdorff, px; samples only unless
+//! `--art-deviation`), IoU with the thresholded bitmap, and the time of the
+//! whole commands, pairwise (see `time_commands` in the support module):
+//! the median of RUNS pairs' ratios (default 7), with the median and the
+//! worst ratio over all bitmaps at the end.
 //!
 //! ```text
-//! cargo run --release -p flourish-tools --bin compare_potrace [-- RUNS]
+//! cargo build --release
+//! cargo run --release -p flourish-tools --bin compare_potrace [-- RUNS [--art-deviation]]
 //! ```
 //!
 //! The measurement code is shared with `tests/potrace.rs`
 //! (`tests/support/mod.rs`, where the ground truth and the distance are
-//! documented). flourish is timed in-process (`trace_file`, PNG decoding
-//! included); potrace as a process (wall clock, PBM already written).
+//! documented). flourish is timed as the process `target/release/flourish`
+//! (`$FLOURISH_BIN`) reading the PNG; potrace as a process reading the PBM,
+//! written beforehand.
 
 #[path = "../../../tests/support/mod.rs"]
 mod support;
+
+use std::path::PathBuf;
 
 fn main() {
     if !support::potrace_available() {
@@ -36,52 +46,77 @@ fn main() {
         explain(name, &dir, at, half);
         return;
     }
-    let runs: usize = args.first().and_then(|s| s.parse().ok()).unwrap_or(5);
-    let mut names: Vec<String> = std::fs::read_dir(support::root().join("samples/trace"))
-        .expect("samples/trace")
-        .filter_map(|e| e.ok())
-        .map(|e| e.file_name().to_string_lossy().to_string())
-        .filter(|n| n.ends_with(".png"))
+    if !support::flourish_bin().exists() {
+        eprintln!(
+            "{} not found: cargo build --release first",
+            support::flourish_bin().display()
+        );
+        std::process::exit(1);
+    }
+    let runs: usize = args.first().and_then(|s| s.parse().ok()).unwrap_or(7);
+    let art_deviation = args.iter().any(|a| a == "--art-deviation");
+    let pngs = |dir: PathBuf| -> Vec<PathBuf> {
+        let mut v: Vec<PathBuf> = std::fs::read_dir(&dir)
+            .map(|d| d.filter_map(|e| e.ok()).map(|e| e.path()).collect())
+            .unwrap_or_default();
+        v.retain(|p| p.extension().is_some_and(|e| e == "png"));
+        v.sort();
+        v
+    };
+    let mut files: Vec<(PathBuf, bool)> = pngs(support::root().join("samples/trace"))
+        .into_iter()
         // flourish traces every ink of a picture in several (the light gold
         // disc too), potrace's threshold only the dark ones.
-        .filter(|n| !n.starts_with("two-colour"))
+        .filter(|p| !p.to_string_lossy().contains("two-colour"))
+        .map(|p| (p, true))
         .collect();
-    names.sort();
-    println!("Median of {runs} runs; potrace -t {}; deviations are symmetric Hausdorff distances (px) to the SVG ground truth; IoU: rendered output vs 50 %-thresholded input.\n", support::potrace_turdsize());
-    println!("| file | size | flourish segments | potrace segments | segment ratio | flourish max dev | potrace max dev | flourish median ms | potrace median ms | time ratio | flourish IoU | potrace IoU |");
+    let art = std::env::var_os("FLOURISH_ART")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| support::root().join("../shared/art"));
+    files.extend(
+        pngs(art.join("trace"))
+            .into_iter()
+            .map(|p| (p, art_deviation)),
+    );
+    println!("Whole commands, {runs} pairs each (flourish and potrace back to back, alternating which goes first), after one untimed run of each; time ratio: median of the pairs' flourish/potrace; ms: medians. potrace -t {}; deviations are symmetric Hausdorff distances (px) to the SVG ground truth (— where not measured); IoU: rendered output vs 50 %-thresholded input.\n", support::potrace_turdsize());
+    println!("| file | size | flourish segments | potrace segments | segment ratio | flourish max dev | potrace max dev | flourish ms | potrace ms | time ratio | flourish IoU | potrace IoU |");
     println!("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     let (mut fs, mut ps) = (0usize, 0usize);
-    for name in &names {
-        let c = support::compare(name, runs);
+    let mut ratios = Vec::new();
+    let dev = |d: Option<f64>| d.map_or("—".to_string(), |d| format!("{d:.3}"));
+    for (png, deviation) in &files {
+        let c = support::compare_file(png, runs, *deviation);
         fs += c.flourish_segments;
         ps += c.potrace_segments;
-        let fms = c.flourish_time.as_secs_f64() * 1e3;
-        let pms = c.potrace_time.as_secs_f64() * 1e3;
+        ratios.push((c.times.ratio, c.name.clone()));
         println!(
-            "| {} | {}x{} | {} | {} | {:.3} | {:.3} ({:.2}/{:.2}) | {:.3} ({:.2}/{:.2}) | {:.1} | {:.1} | {:.2} | {:.4} | {:.4} |",
+            "| {} | {}x{} | {} | {} | {:.3} | {} | {} | {:.1} | {:.1} | {:.2} | {:.4} | {:.4} |",
             c.name,
             c.width,
             c.height,
             c.flourish_segments,
             c.potrace_segments,
             c.flourish_segments as f64 / c.potrace_segments as f64,
-            c.flourish_dev,
-            c.flourish_dev_dir.0,
-            c.flourish_dev_dir.1,
-            c.potrace_dev,
-            c.potrace_dev_dir.0,
-            c.potrace_dev_dir.1,
-            fms,
-            pms,
-            fms / pms,
+            dev(c.flourish_dev),
+            dev(c.potrace_dev),
+            c.times.flourish.as_secs_f64() * 1e3,
+            c.times.potrace.as_secs_f64() * 1e3,
+            c.times.ratio,
             c.flourish_iou,
             c.potrace_iou,
         );
     }
-    println!(
-        "\nAll samples: flourish {fs} segments, potrace {ps} (ratio {:.3}). Max dev in parentheses: (output→truth / truth→output). Ratios are flourish / potrace.",
-        fs as f64 / ps as f64
-    );
+    ratios.sort_by(|a, b| a.0.total_cmp(&b.0));
+    if let (Some(mid), Some(worst)) = (ratios.get(ratios.len() / 2), ratios.last()) {
+        println!(
+            "\nAll {} bitmaps: flourish {fs} segments, potrace {ps} (ratio {:.3}); time ratio median {:.2}, worst {:.2} ({}). Ratios are flourish / potrace.",
+            ratios.len(),
+            fs as f64 / ps as f64,
+            mid.0,
+            worst.0,
+            worst.1,
+        );
+    }
 }
 
 /// `--explain NAME.png OUTDIR [X Y [HALF]]`: where each tracer deviates most.
