@@ -323,3 +323,226 @@ fn specks_are_left_out_of_fill_and_pattern_with_a_warning() {
         assert!(svg.contains(r#"id="big""#), "{mode}: {svg}");
     }
 }
+
+/// Runs flourish under `ulimit -v` (address space, `mib` MiB) with a hang
+/// guard of `guard_s` seconds; returns exit code, stderr.
+fn capped(args: &[&str], mib: u64, guard_s: u64) -> (Option<i32>, String) {
+    use std::time::{Duration, Instant};
+    let script = format!("ulimit -v {} && exec \"$0\" \"$@\"", mib * 1024);
+    let mut child = Command::new("sh")
+        .arg("-c")
+        .arg(script)
+        .arg(env!("CARGO_BIN_EXE_flourish"))
+        .args(args)
+        .env("FLOURISH_CACHE_DIR", folder("hostile-cache"))
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("sh runs");
+    let start = Instant::now();
+    while child.try_wait().expect("wait").is_none() {
+        if start.elapsed() > Duration::from_secs(guard_s) {
+            let _ = child.kill();
+            panic!("{args:?}: still running after {guard_s} s");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let out = child.wait_with_output().expect("output");
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// Each hostile or merely awkward input of the issue tracker's list, under
+/// a 2 GiB address-space cap and a hang guard: a valid output, or exit 1
+/// with one line naming the file. Never an abort, a signal or a hang.
+#[test]
+fn hostile_inputs_end_in_a_valid_output_or_one_line() {
+    let dir = folder("hostile");
+    let w = |name: &str, text: String| {
+        let p = dir.join(name);
+        std::fs::write(&p, text).expect("an input");
+        p
+    };
+    let svg = |body: &str| {
+        format!(r#"<svg xmlns="http://www.w3.org/2000/svg" width="800" height="600">{body}</svg>"#)
+    };
+    // 300,000 points in one path, stroked and as a region.
+    let mut d = String::from("M400 300");
+    for i in 1..300_000 {
+        let t = i as f64 * 1e-3;
+        let r = 250.0 * (0.5 + 0.5 * (t * 0.3).sin());
+        d.push_str(&format!(
+            " L{:.2} {:.2}",
+            400.0 + r * t.cos(),
+            300.0 + r * t.sin()
+        ));
+    }
+    let points = w(
+        "points.svg",
+        svg(&format!(
+            r##"<path d="{d}" fill="none" stroke="#000" stroke-width="12"/>"##
+        )),
+    );
+    let points_region = w(
+        "points-region.svg",
+        svg(&format!(r##"<path d="{d} Z" fill="#000"/>"##)),
+    );
+    // Arcs with 1e308 radii and coordinates, beside a shape that is fine.
+    let arcs = w(
+        "arcs.svg",
+        svg(
+            r##"<path d="M10 10 A1e308 1e308 0 0 1 1e308 1e308" fill="none" stroke="#000" stroke-width="5"/><path d="M100 100 C200 0 300 200 400 100" fill="none" stroke="#000" stroke-width="20"/><circle cx="600" cy="300" r="80" fill="#000"/>"##,
+        ),
+    );
+    // One coordinate of 3.4e38.
+    let far = w(
+        "far.svg",
+        svg(
+            r##"<path d="M10 10 L3.4e38 20" fill="none" stroke="#000" stroke-width="5"/><path d="M100 100 L400 120" fill="none" stroke="#000" stroke-width="20"/>"##,
+        ),
+    );
+    // A sketch 0.0001 units high.
+    let flat = w(
+        "flat.svg",
+        r##"<svg xmlns="http://www.w3.org/2000/svg" width="0.0001" height="0.0001" viewBox="0 0 0.0001 0.0001"><rect width="0.0001" height="0.0001" fill="#000"/></svg>"##.to_string(),
+    );
+    // 2,000 regions, each patterned with many elements.
+    let mut many = String::new();
+    for i in 0..2000 {
+        let (x, y) = ((i % 50) * 16 + 8, (i / 50) * 15 + 8);
+        many.push_str(&format!(
+            r##"<rect x="{x}" y="{y}" width="14" height="13" fill="#000"/>"##
+        ));
+    }
+    let regions = w("regions.svg", svg(&many));
+    // A style of 20,000 exemplars, and one whose exemplar is a FIFO.
+    let crowd = dir.join("crowd");
+    std::fs::create_dir_all(&crowd).expect("a style folder");
+    let mut toml = String::from("kind = \"fill\"\n");
+    for i in 0..20_000 {
+        toml.push_str(&format!("[[exemplar]]\nfile = \"e{i}.svg\"\n"));
+    }
+    std::fs::write(crowd.join("style.toml"), toml).expect("style.toml");
+    let fifo_style = dir.join("fifo");
+    std::fs::create_dir_all(&fifo_style).expect("a style folder");
+    std::fs::write(
+        fifo_style.join("style.toml"),
+        "kind = \"fill\"\n[[exemplar]]\nfile = \"tile.svg\"\n",
+    )
+    .expect("style.toml");
+    let fifo = Command::new("mkfifo")
+        .arg(fifo_style.join("tile.svg"))
+        .status()
+        .is_ok_and(|s| s.success());
+
+    let out = dir.join("out.svg");
+    let o = out.to_str().expect("utf-8");
+    let p = |x: &std::path::Path| x.to_str().expect("utf-8").to_string();
+    let mut cases: Vec<(Vec<String>, String)> = vec![
+        (
+            vec![
+                "pattern".into(),
+                "--style".into(),
+                "stipple".into(),
+                p(&points),
+            ],
+            p(&points),
+        ),
+        (
+            vec![
+                "fill".into(),
+                "--style".into(),
+                "knot".into(),
+                p(&points_region),
+            ],
+            p(&points_region),
+        ),
+        (
+            vec!["brush".into(), "--style".into(), "vine".into(), p(&arcs)],
+            p(&arcs),
+        ),
+        (
+            vec![
+                "pattern".into(),
+                "--style".into(),
+                "stipple".into(),
+                p(&arcs),
+            ],
+            p(&arcs),
+        ),
+        (
+            vec!["fill".into(), "--style".into(), "knot".into(), p(&arcs)],
+            p(&arcs),
+        ),
+        (
+            vec![
+                "pattern".into(),
+                "--style".into(),
+                "stipple".into(),
+                p(&far),
+            ],
+            p(&far),
+        ),
+        (
+            vec!["brush".into(), "--style".into(), "vine".into(), p(&far)],
+            p(&far),
+        ),
+        (vec!["trace".into(), p(&flat)], p(&flat)),
+        (
+            vec!["fill".into(), "--style".into(), "knot".into(), p(&flat)],
+            p(&flat),
+        ),
+        (
+            vec![
+                "pattern".into(),
+                "--style".into(),
+                "stipple".into(),
+                p(&regions),
+            ],
+            p(&regions),
+        ),
+        (
+            vec!["fill".into(), "--style".into(), p(&crowd), p(&arcs)],
+            "style.toml".into(),
+        ),
+    ];
+    if fifo {
+        cases.push((
+            vec!["fill".into(), "--style".into(), p(&fifo_style), p(&arcs)],
+            "tile.svg".into(),
+        ));
+    }
+    for (args, named) in cases {
+        let _ = std::fs::remove_file(&out);
+        let mut all: Vec<&str> = args.iter().map(String::as_str).collect();
+        all.extend(["-o", o]);
+        let (code, err) = capped(&all, 2048, 300);
+        match code {
+            Some(0) => {
+                let bytes = std::fs::read(&out).expect("an output");
+                let tree = resvg::usvg::Tree::from_data(&bytes, &resvg::usvg::Options::default())
+                    .unwrap_or_else(|e| panic!("{args:?}: invalid output: {e}"));
+                assert!(
+                    tree.size().width() > 0.0 && tree.size().height() > 0.0,
+                    "{args:?}: zero size"
+                );
+                let paths = String::from_utf8_lossy(&bytes).matches("<path").count();
+                assert!(paths <= 200_000, "{args:?}: {paths} paths");
+            }
+            Some(1) => {
+                let lines: Vec<&str> = err.lines().filter(|l| !l.contains("warning")).collect();
+                assert_eq!(lines.len(), 1, "{args:?}: {err}");
+                let name = std::path::Path::new(&named)
+                    .file_name()
+                    .and_then(|n| n.to_str())
+                    .expect("a name");
+                assert!(lines[0].contains(name), "{args:?}: {err}");
+                assert!(!out.exists(), "{args:?}: output left");
+            }
+            other => panic!("{args:?}: exit {other:?}: {err}"),
+        }
+    }
+}
