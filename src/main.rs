@@ -1235,27 +1235,13 @@ mod budget {
     // pointer; the counting around it neither allocates nor locks.
     unsafe impl GlobalAlloc for Counting {
         unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-            if !flourish::memory::reserve(layout.size()) {
-                over_budget(layout.size());
-            }
             // SAFETY: forwarded with the caller's layout.
-            let p = unsafe { System.alloc(layout) };
-            if p.is_null() {
-                flourish::memory::release(layout.size());
-            }
-            p
+            counted(layout.size(), || unsafe { System.alloc(layout) })
         }
 
         unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-            if !flourish::memory::reserve(layout.size()) {
-                over_budget(layout.size());
-            }
             // SAFETY: forwarded with the caller's layout.
-            let p = unsafe { System.alloc_zeroed(layout) };
-            if p.is_null() {
-                flourish::memory::release(layout.size());
-            }
-            p
+            counted(layout.size(), || unsafe { System.alloc_zeroed(layout) })
         }
 
         unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
@@ -1280,6 +1266,19 @@ mod budget {
             }
             p
         }
+    }
+
+    /// Counts `size` bytes against the budget (ending the run when they do
+    /// not fit), then allocates them; a failed allocation counts nothing.
+    fn counted(size: usize, allocate: impl FnOnce() -> *mut u8) -> *mut u8 {
+        if !flourish::memory::reserve(size) {
+            over_budget(size);
+        }
+        let p = allocate();
+        if p.is_null() {
+            flourish::memory::release(size);
+        }
+        p
     }
 
     /// A fixed buffer that formats without allocating.

@@ -545,6 +545,24 @@ pub fn potrace_available() -> bool {
         .unwrap_or(false)
 }
 
+/// Runs `potrace -s` with the speck size of [`potrace_turdsize`] on `pbm`,
+/// writing `svg`; the wall time of the whole process.
+pub fn potrace_process(pbm: &Path, svg: &Path) -> Duration {
+    let t = Instant::now();
+    let st = Command::new("potrace")
+        .arg("-s")
+        .arg("-t")
+        .arg(potrace_turdsize().to_string())
+        .arg("-o")
+        .arg(svg)
+        .arg(pbm)
+        .status()
+        .expect("run potrace");
+    let e = t.elapsed();
+    assert!(st.success(), "potrace failed: {st}");
+    e
+}
+
 /// Ink mask of a bitmap: luma < 128.
 pub fn ink_mask(bitmap: &image::GrayImage) -> Vec<bool> {
     bitmap.pixels().map(|p| p[0] < 128).collect()
@@ -614,18 +632,7 @@ pub fn run_potrace(bitmap: &image::GrayImage, runs: usize) -> (Vec<BezPath>, usi
     let mut times = Vec::new();
     for _ in 0..runs.max(1) {
         let _ = std::fs::remove_file(&svg);
-        let t = Instant::now();
-        let st = Command::new("potrace")
-            .arg("-s")
-            .arg("-t")
-            .arg(potrace_turdsize().to_string())
-            .arg("-o")
-            .arg(&svg)
-            .arg(&pbm)
-            .status()
-            .expect("run potrace");
-        times.push(t.elapsed());
-        assert!(st.success(), "potrace failed: {st}");
+        times.push(potrace_process(&pbm, &svg));
     }
     let tree = load_svg(&svg);
     // potrace writes width/height in pt; map the tree's size onto the bitmap.
@@ -853,21 +860,7 @@ pub fn time_commands(png: &Path, bitmap: &image::GrayImage, runs: usize) -> Comm
         );
         e
     };
-    let potrace = || {
-        let t = Instant::now();
-        let st = Command::new("potrace")
-            .arg("-s")
-            .arg("-t")
-            .arg(potrace_turdsize().to_string())
-            .arg("-o")
-            .arg(&psvg)
-            .arg(&pbm)
-            .status()
-            .expect("run potrace");
-        let e = t.elapsed();
-        assert!(st.success(), "potrace failed: {st}");
-        e
-    };
+    let potrace = || potrace_process(&pbm, &psvg);
     flourish();
     potrace();
     let (mut ft, mut pt, mut ratios) = (Vec::new(), Vec::new(), Vec::new());
