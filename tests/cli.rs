@@ -21,6 +21,7 @@ const SENTINEL: &[u8] = b"do not touch\n";
 fn flourish(args: &[&str]) -> Output {
     Command::new(BIN)
         .args(args)
+        .env("FLOURISH_PROGRESS_AFTER", "100000")
         .stdin(Stdio::null())
         .output()
         .expect("run flourish")
@@ -32,6 +33,7 @@ fn flourish(args: &[&str]) -> Output {
 fn flourish_guarded(dir: &Path, args: &[&str], limit: Duration) -> Output {
     let start = Instant::now();
     let mut child = Command::new(BIN)
+        .env("FLOURISH_PROGRESS_AFTER", "100000")
         .args(args)
         .current_dir(dir)
         .stdin(Stdio::null())
@@ -78,6 +80,7 @@ fn flourish_capped(dir: &Path, args: &[&str], mib: u64) -> Output {
         .arg(script)
         .arg(BIN)
         .args(args)
+        .env("FLOURISH_PROGRESS_AFTER", "100000")
         .current_dir(dir)
         .stdin(Stdio::null())
         .output()
