@@ -36,13 +36,14 @@ pub struct BrushOutput {
 
 /// Rings (canvas px) by which the coordinate field is continued beyond
 /// the region the matched segments cover before it is read: two
-/// start-level pixels and two more. The covered region is rasterized at
-/// the start level and upsampled by whole parents, so its edge is a
-/// staircase of coarse pixels; where an exemplar's ink reaches its rib
-/// outline (a spike's tip, a curl's end) the region edge would clip it
-/// along that staircase, in square steps.
+/// start-level pixels and two more, and [`REACH_MARGIN`] rounded up to
+/// whole pixels past which ink is cut ([`Reach`]). The covered region is
+/// rasterized at the start level and upsampled by whole parents, so its
+/// edge is a staircase of coarse pixels; where an exemplar's ink reaches
+/// its rib outline (a spike's tip, a curl's end) the region edge would
+/// clip it along that staircase, in square steps.
 pub fn border_rings(r: &QueryResult) -> usize {
-    2 * r.canvas.factor.max(1) + 2
+    2 * r.canvas.factor.max(1) + 2 + REACH_MARGIN.ceil() as usize
 }
 
 /// [`extend_owned`] on a copy of `field`.
@@ -205,6 +206,39 @@ const NEIGHBOURS: [(isize, isize); 8] = [
     (1, 1),
 ];
 
+/// How far the continuation may carry ink: the Euclidean distance from
+/// the covered region (canvas px), and the distance at which ink is cut,
+/// [`REACH_MARGIN`] inside the last continued ring. The rings grow by
+/// 8-neighbours, so every pixel within `rings` px (Euclidean) of the
+/// covered region is continued; a cut along this distance's level line is
+/// smooth where the rings' own edge is a staircase of canvas pixels.
+struct Reach {
+    dist: Grid<f32>,
+    cut: f32,
+}
+
+/// Canvas px inside the last continued ring at which ink is cut: one and
+/// a half pixels, so the two canvas pixels every output pixel reads
+/// across on each axis are continued wherever ink survives the cut.
+const REACH_MARGIN: f32 = 1.5;
+
+impl Reach {
+    /// The reach of continuing `coords` by `rings` px.
+    fn of(coords: &Grid<Option<Coord>>, rings: usize) -> Reach {
+        let covered = coords.map(|c| c.is_some());
+        Reach {
+            dist: crate::raster::edt::squared_edt(&covered).map(f32::sqrt),
+            cut: rings as f32 - REACH_MARGIN,
+        }
+    }
+
+    /// Canvas px beyond the cut at canvas point `(x, y)` (pixel centres at
+    /// half-integers), negative inside it.
+    fn beyond(&self, x: f32, y: f32) -> f32 {
+        self.dist.sample(x as f64, y as f64) - self.cut
+    }
+}
+
 /// The Jacobians of a field's covered pixels ([`synth::jacobian`]), held
 /// compactly: per pixel an index into the list of Jacobians
 /// ([`NO_JACOBIAN`] for none), so a thin stroke across a large canvas does
@@ -303,8 +337,17 @@ fn sample_beyond(g: &Grid<f32>, x: f32, y: f32) -> f32 {
 /// μ landed on another layer's ink is outvoted (the output reading of
 /// decobrush.txt §5.4: colours are read through μ, §7). A neighbour whose
 /// exemplar lacks a colour gives paper for it. The field's Jacobians are
-/// measured beforehand (`jac`).
-fn read_layers(style: &BrushStyle, field: &Field, jac: &Jacobians, sub: usize) -> Vec<Grid<f32>> {
+/// measured beforehand (`jac`). Every layer is intersected with the
+/// continuation's reach ([`Reach`]), so ink the continuation carries out
+/// of the covered region ends on a smooth line, not on the staircase of
+/// its last ring.
+fn read_layers(
+    style: &BrushStyle,
+    field: &Field,
+    jac: &Jacobians,
+    sub: usize,
+    reach: &Reach,
+) -> Vec<Grid<f32>> {
     let palette = &style.facts.palette;
     let g = &field.coords;
     let (w, h) = (g.width(), g.height());
@@ -435,7 +478,10 @@ fn read_layers(style: &BrushStyle, field: &Field, jac: &Jacobians, sub: usize) -
                     / wsum
                     * to_out
             };
-            let ink = read(None);
+            // Beyond the continuation's reach the ornament is cut along
+            // a smooth line, output px.
+            let cut = reach.beyond(px + 0.5, py + 0.5) * k as f32;
+            let ink = read(None).max(cut);
             if ink >= FAR {
                 for row in out.iter_mut() {
                     row[ox] = ink;
@@ -443,7 +489,7 @@ fn read_layers(style: &BrushStyle, field: &Field, jac: &Jacobians, sub: usize) -
                 continue;
             }
             for (l, row) in out.iter_mut().enumerate() {
-                row[ox] = read(Some(l));
+                row[ox] = read(Some(l)).max(cut);
             }
         }
     });
@@ -497,9 +543,12 @@ pub fn debris_area(style: &BrushStyle) -> f64 {
 /// query's largest piece is its body and always stays. `field` is the
 /// query's field (or a copy of it), used up.
 fn final_layers_with(style: &BrushStyle, r: &QueryResult, field: Field) -> Vec<(Color, Grid<f32>)> {
-    let field = extend_owned(style, field, border_rings(r));
+    let rings = border_rings(r);
+    let reach = Reach::of(&field.coords, rings);
+    let field = extend_owned(style, field, rings);
     let jac = Jacobians::of(style, &field);
-    let read = read_layers(style, &field, &jac, r.sub);
+    let read = read_layers(style, &field, &jac, r.sub, &reach);
+    drop(reach);
     drop(jac);
     let mut layers: Vec<(Color, Grid<f32>)> =
         style.facts.palette.iter().copied().zip(read).collect();

@@ -181,3 +181,40 @@ fn many_small_strokes_each_trace_as_alone() {
         assert_eq!(&alone, g, "{}", g.id);
     }
 }
+
+#[test]
+fn continued_ink_ends_within_the_continuations_reach() {
+    use crate::brush::output::{border_rings, final_layers};
+    let style = vine();
+    let svg = r#"<svg xmlns="http://www.w3.org/2000/svg" width="200" height="120" viewBox="0 0 200 120"><path d="M20 80 C 60 10, 120 10, 180 70" fill="none" stroke="black" stroke-width="16"/></svg>"#;
+    let sk = crate::read::sketch::parse(svg.as_bytes()).expect("parses");
+    let keep = Settings {
+        discard_fields: false,
+        ..Settings::default()
+    };
+    let out = brush_sketch(style, &sk, &keep).expect("brushes");
+    let r = &out.queries[0];
+    let covered = r.field.coords.map(|c| c.is_some());
+    let dist = crate::raster::edt::squared_edt(&covered).map(f32::sqrt);
+    let k = r.sub.max(1);
+    // The last continued ring less the documented margin, and the cross-
+    // fade of one canvas pixel beyond it.
+    let reach = border_rings(r) as f32 - 1.5 + 1.0;
+    let (mut inked, mut beyond) = (0usize, 0usize);
+    for (_, g) in final_layers(style, r) {
+        for oy in 0..g.height() {
+            for ox in 0..g.width() {
+                if g.get(ox, oy) >= 0.0 {
+                    continue;
+                }
+                inked += 1;
+                let d = dist.get(ox / k, oy / k);
+                if d > reach {
+                    beyond += 1;
+                }
+            }
+        }
+    }
+    assert!(inked > 0);
+    assert_eq!(beyond, 0, "{beyond} of {inked} ink px beyond the reach");
+}
