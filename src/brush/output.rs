@@ -310,6 +310,9 @@ struct Source<'a> {
 /// continued coordinate leaves the image).
 fn sample_beyond(g: &Grid<f32>, x: f32, y: f32) -> f32 {
     let (w, h) = (g.width() as f32, g.height() as f32);
+    if (0.0..=w).contains(&x) && (0.0..=h).contains(&y) {
+        return g.sample(x as f64, y as f64);
+    }
     let (cx, cy) = (x.clamp(0.0, w), y.clamp(0.0, h));
     let v = g.sample(cx as f64, cy as f64);
     let out = (x - cx).hypot(y - cy);
