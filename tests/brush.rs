@@ -1,5 +1,6 @@
 //! `flourish brush` on the command line: variations written side by side,
-//! and a sketch with nothing to brush refused in one line with no output.
+//! a sketch with nothing to brush refused in one line with no output, and
+//! exemplars with no clear main branch warned about and still used.
 
 use std::path::PathBuf;
 
@@ -64,4 +65,60 @@ fn cli_writes_variations_and_fails_cleanly() {
         "{err}"
     );
     assert!(!out.exists(), "no output on failure");
+}
+
+/// A library of a ring and a dot with no `start`/`end`: each is named in
+/// one warning line saying it has no clear main branch, and the fallback
+/// spine (across the drawing's longer side) still brushes the stroke:
+/// exit 0 and ink along it.
+#[test]
+fn exemplars_without_a_main_branch_warn_and_fall_back() {
+    let bin = env!("CARGO_BIN_EXE_flourish");
+    let dir = tempfile::tempdir().unwrap();
+    let lib = dir.path().join("rings");
+    std::fs::create_dir(&lib).unwrap();
+    std::fs::write(
+        lib.join("ring.svg"),
+        r##"<svg xmlns="http://www.w3.org/2000/svg" width="100" height="100"><circle cx="50" cy="50" r="30" fill="none" stroke="#000" stroke-width="8"/></svg>"##,
+    )
+    .unwrap();
+    std::fs::write(
+        lib.join("dot.svg"),
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="100" height="100"><circle cx="50" cy="50" r="30"/></svg>"#,
+    )
+    .unwrap();
+    std::fs::write(
+        lib.join("style.toml"),
+        "kind = \"brush\"\nresolution = 128\n\n[[exemplar]]\nfile = \"ring.svg\"\n\n[[exemplar]]\nfile = \"dot.svg\"\n",
+    )
+    .unwrap();
+    let out = dir.path().join("o.svg");
+    let r = std::process::Command::new(bin)
+        .args([
+            "brush",
+            "--style",
+            lib.to_str().unwrap(),
+            "--cache",
+            dir.path().join("cache").to_str().unwrap(),
+            root().join("samples/brush/s-curve.svg").to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(r.status.success(), "{err}");
+    for file in ["ring.svg", "dot.svg"] {
+        let lines: Vec<&str> = err.lines().filter(|l| l.contains(file)).collect();
+        assert_eq!(lines.len(), 1, "{file}: {err}");
+        assert!(
+            lines[0].contains("warning") && lines[0].contains("no clear main branch"),
+            "{err}"
+        );
+    }
+    let svg = std::fs::read_to_string(&out).unwrap();
+    assert!(
+        svg.contains("<g id=\"s-curve\"") && svg.contains("<path"),
+        "{svg}"
+    );
 }

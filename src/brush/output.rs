@@ -16,6 +16,7 @@ use crate::read::sketch::Sketch;
 use crate::svg_out::{decimals_for, Color, Document, FillRule, Group, Shape};
 use crate::trace::{trace_sdf, TraceOptions};
 use rayon::prelude::*;
+use std::collections::HashMap;
 
 /// Signed distance written off the ornament, px (paper).
 const PAPER: f32 = 8.0;
@@ -35,13 +36,14 @@ pub struct BrushOutput {
 
 /// Rings (canvas px) by which the coordinate field is continued beyond
 /// the region the matched segments cover before it is read: two
-/// start-level pixels and two more. The covered region is rasterized at
-/// the start level and upsampled by whole parents, so its edge is a
-/// staircase of coarse pixels; where an exemplar's ink reaches its rib
-/// outline (a spike's tip, a curl's end) the region edge would clip it
-/// along that staircase, in square steps.
+/// start-level pixels and two more, and [`REACH_MARGIN`] rounded up to
+/// whole pixels past which ink is cut ([`Reach`]). The covered region is
+/// rasterized at the start level and upsampled by whole parents, so its
+/// edge is a staircase of coarse pixels; where an exemplar's ink reaches
+/// its rib outline (a spike's tip, a curl's end) the region edge would
+/// clip it along that staircase, in square steps.
 pub fn border_rings(r: &QueryResult) -> usize {
-    2 * r.canvas.factor.max(1) + 2
+    2 * r.canvas.factor.max(1) + 2 + REACH_MARGIN.ceil() as usize
 }
 
 /// [`extend_owned`] on a copy of `field`.
@@ -51,9 +53,16 @@ pub fn extend_field(style: &BrushStyle, field: &Field, rings: usize) -> Field {
 }
 
 /// The field `f` continued `rings` pixels beyond its covered region: ring
-/// by ring, an uncovered pixel with covered 8-neighbours takes the
-/// continuation `μ(q) + J(q)(p − q)` of the first of them in scan order
-/// whose exemplar is the most common among them ([`synth::jacobian`]).
+/// by ring, an uncovered pixel `p` with covered or continued 8-neighbours
+/// takes, from the first of them in scan order whose exemplar is the most
+/// common among them, that neighbour's source `q` (a covered pixel: itself,
+/// or the one it was continued from) and the continuation
+/// `μ(q) + J(q)(p − q)` ([`synth::jacobian`], measured on the covered
+/// field). Continuing from the covered source, not from the last ring,
+/// keeps the continuation one affine patch per source: a Jacobian measured
+/// again on continued pixels compounds its error ring by ring, and
+/// squeezed patches map whole rings onto one spot of ink (blobs with
+/// square steps beside the ornament).
 fn extend_owned(style: &BrushStyle, mut f: Field, rings: usize) -> Field {
     let (w, h) = (f.coords.width(), f.coords.height());
     // Only pixels next to the covered region can be reached: each ring
@@ -62,6 +71,8 @@ fn extend_owned(style: &BrushStyle, mut f: Field, rings: usize) -> Field {
     let Some(mut bx) = covered_box(&f.coords) else {
         return f;
     };
+    // Continued pixels (row-major index) and their source.
+    let mut carried: HashMap<usize, Origin> = HashMap::new();
     for _ in 0..rings {
         bx = [
             bx[0].saturating_sub(1),
@@ -71,55 +82,77 @@ fn extend_owned(style: &BrushStyle, mut f: Field, rings: usize) -> Field {
         ];
         // Every pixel of a ring reads the field as it was before the ring
         // (the updates are gathered first, then written).
-        let snap = &f;
+        let (snap, held) = (&f, &carried);
         let rows: Vec<(usize, Vec<Continued>)> = (bx[1]..=bx[3])
             .into_par_iter()
             .map(|y| {
                 let mut out = Vec::new();
+                let mut counts: Vec<(u32, usize)> = Vec::new();
+                let mut firsts: Vec<(u32, (isize, isize))> = Vec::new();
                 for x in bx[0]..=bx[2] {
                     if snap.coords.get(x, y).is_some() {
                         continue;
                     }
-                    let mut best: Option<Continued> = None;
-                    let mut counts: Vec<(u32, usize)> = Vec::new();
-                    let mut preds: Vec<(u32, Coord, [f32; 2])> = Vec::new();
+                    counts.clear();
+                    firsts.clear();
                     for (dx, dy) in NEIGHBOURS {
                         let (nx, ny) = (x as isize + dx, y as isize + dy);
                         let Some(c) = snap.coords.get_or(nx, ny, None) else {
                             continue;
                         };
-                        let (nx, ny) = (nx as usize, ny as usize);
-                        let Some(j) = synth::jacobian(style, snap, nx, ny) else {
-                            continue;
-                        };
-                        let d = synth::apply(j, [-dx as f32, -dy as f32]);
-                        let p = Coord {
-                            exemplar: c.exemplar,
-                            x: c.x + d[0],
-                            y: c.y + d[1],
-                        };
                         match counts.iter_mut().find(|(e, _)| *e == c.exemplar) {
                             Some(k) => k.1 += 1,
-                            None => counts.push((c.exemplar, 1)),
+                            None => {
+                                counts.push((c.exemplar, 1));
+                                firsts.push((c.exemplar, (nx, ny)));
+                            }
                         }
-                        preds.push((c.exemplar, p, snap.orient.get(nx, ny)));
                     }
                     let top = counts.iter().map(|c| c.1).max().unwrap_or(0);
-                    if let Some((e, _)) = counts.iter().find(|c| c.1 == top) {
-                        if let Some((_, p, o)) = preds.iter().find(|p| p.0 == *e) {
-                            best = Some((x, *p, *o));
+                    let Some((e, _)) = counts.iter().find(|c| c.1 == top) else {
+                        continue;
+                    };
+                    let Some(&(_, (nx, ny))) = firsts.iter().find(|p| p.0 == *e) else {
+                        continue;
+                    };
+                    let (nx, ny) = (nx as usize, ny as usize);
+                    let src = match held.get(&(ny * w + nx)) {
+                        Some(s) => *s,
+                        None => {
+                            let (Some(c), Some(j)) = (
+                                snap.coords.get(nx, ny),
+                                synth::jacobian(style, snap, nx, ny),
+                            ) else {
+                                continue;
+                            };
+                            Origin {
+                                at: (nx, ny),
+                                coord: c,
+                                jac: j,
+                                orient: snap.orient.get(nx, ny),
+                            }
                         }
-                    }
-                    out.extend(best);
+                    };
+                    let d = synth::apply(
+                        src.jac,
+                        [x as f32 - src.at.0 as f32, y as f32 - src.at.1 as f32],
+                    );
+                    let c = Coord {
+                        exemplar: src.coord.exemplar,
+                        x: src.coord.x + d[0],
+                        y: src.coord.y + d[1],
+                    };
+                    out.push((x, c, src));
                 }
                 (y, out)
             })
             .collect();
         let mut any = false;
         for (y, row) in rows {
-            for (x, c, o) in row {
+            for (x, c, src) in row {
                 f.coords.set(x, y, Some(c));
-                f.orient.set(x, y, o);
+                f.orient.set(x, y, src.orient);
+                carried.insert(y * w + x, src);
                 any = true;
             }
         }
@@ -130,9 +163,18 @@ fn extend_owned(style: &BrushStyle, mut f: Field, rings: usize) -> Field {
     f
 }
 
-/// A pixel the continuation reaches: its column, coordinate and
-/// orientation.
-type Continued = (usize, Coord, [f32; 2]);
+/// The covered pixel a continued pixel is continued from: its position
+/// (canvas px), coordinate, Jacobian and orientation.
+#[derive(Clone, Copy, Debug)]
+struct Origin {
+    at: (usize, usize),
+    coord: Coord,
+    jac: synth::Jacobian,
+    orient: [f32; 2],
+}
+
+/// A pixel the continuation reaches: its column, coordinate and source.
+type Continued = (usize, Coord, Origin);
 
 /// The box `[x0, y0, x1, y1]` (inclusive) of the covered pixels of a
 /// coordinate grid, `None` when none is covered.
@@ -163,6 +205,39 @@ const NEIGHBOURS: [(isize, isize); 8] = [
     (0, 1),
     (1, 1),
 ];
+
+/// How far the continuation may carry ink: the Euclidean distance from
+/// the covered region (canvas px), and the distance at which ink is cut,
+/// [`REACH_MARGIN`] inside the last continued ring. The rings grow by
+/// 8-neighbours, so every pixel within `rings` px (Euclidean) of the
+/// covered region is continued; a cut along this distance's level line is
+/// smooth where the rings' own edge is a staircase of canvas pixels.
+struct Reach {
+    dist: Grid<f32>,
+    cut: f32,
+}
+
+/// Canvas px inside the last continued ring at which ink is cut: one and
+/// a half pixels, so the two canvas pixels every output pixel reads
+/// across on each axis are continued wherever ink survives the cut.
+const REACH_MARGIN: f32 = 1.5;
+
+impl Reach {
+    /// The reach of continuing `coords` by `rings` px.
+    fn of(coords: &Grid<Option<Coord>>, rings: usize) -> Reach {
+        let covered = coords.map(|c| c.is_some());
+        Reach {
+            dist: crate::raster::edt::squared_edt(&covered).map(f32::sqrt),
+            cut: rings as f32 - REACH_MARGIN,
+        }
+    }
+
+    /// Canvas px beyond the cut at canvas point `(x, y)` (pixel centres at
+    /// half-integers), negative inside it.
+    fn beyond(&self, x: f32, y: f32) -> f32 {
+        self.dist.sample(x as f64, y as f64) - self.cut
+    }
+}
 
 /// The Jacobians of a field's covered pixels ([`synth::jacobian`]), held
 /// compactly: per pixel an index into the list of Jacobians
@@ -227,6 +302,27 @@ struct Source<'a> {
     layers: Vec<Option<&'a Grid<f32>>>,
 }
 
+/// An exemplar SDF `g` (finest px) at `(x, y)`, continued beyond the
+/// exemplar's image: outside it, the distance at the nearest point of the
+/// image's edge, no less than paper, combined with the distance to that
+/// edge. Ink that touches the edge then ends there instead of running on
+/// as a band of the edge's samples (a wedge of solid ink wherever a
+/// continued coordinate leaves the image).
+fn sample_beyond(g: &Grid<f32>, x: f32, y: f32) -> f32 {
+    let (w, h) = (g.width() as f32, g.height() as f32);
+    if (0.0..=w).contains(&x) && (0.0..=h).contains(&y) {
+        return g.sample(x as f64, y as f64);
+    }
+    let (cx, cy) = (x.clamp(0.0, w), y.clamp(0.0, h));
+    let v = g.sample(cx as f64, cy as f64);
+    let out = (x - cx).hypot(y - cy);
+    if out > 0.0 {
+        v.max(0.0).hypot(out)
+    } else {
+        v
+    }
+}
+
 /// The layers' SDFs (in the order of the style's palette, output px) read
 /// through a synthesized (already extended) field onto the output grid,
 /// the canvas subdivided `sub` times; `PAPER` off the ornament.
@@ -244,8 +340,17 @@ struct Source<'a> {
 /// μ landed on another layer's ink is outvoted (the output reading of
 /// decobrush.txt §5.4: colours are read through μ, §7). A neighbour whose
 /// exemplar lacks a colour gives paper for it. The field's Jacobians are
-/// measured beforehand (`jac`).
-fn read_layers(style: &BrushStyle, field: &Field, jac: &Jacobians, sub: usize) -> Vec<Grid<f32>> {
+/// measured beforehand (`jac`). Every layer is intersected with the
+/// continuation's reach ([`Reach`]), so ink the continuation carries out
+/// of the covered region ends on a smooth line, not on the staircase of
+/// its last ring.
+fn read_layers(
+    style: &BrushStyle,
+    field: &Field,
+    jac: &Jacobians,
+    sub: usize,
+    reach: &Reach,
+) -> Vec<Grid<f32>> {
     let palette = &style.facts.palette;
     let g = &field.coords;
     let (w, h) = (g.width(), g.height());
@@ -370,13 +475,16 @@ fn read_layers(style: &BrushStyle, field: &Field, jac: &Jacobians, sub: usize) -
                                 None => Some(s.ink),
                                 Some(l) => s.layers.get(l).copied().flatten(),
                             })
-                            .map_or(PAPER, |g| g.sample(x as f64, y as f64))
+                            .map_or(PAPER, |g| sample_beyond(g, x, y))
                     })
                     .sum::<f32>()
                     / wsum
                     * to_out
             };
-            let ink = read(None);
+            // Beyond the continuation's reach the ornament is cut along
+            // a smooth line, output px.
+            let cut = reach.beyond(px + 0.5, py + 0.5) * k as f32;
+            let ink = read(None).max(cut);
             if ink >= FAR {
                 for row in out.iter_mut() {
                     row[ox] = ink;
@@ -384,7 +492,7 @@ fn read_layers(style: &BrushStyle, field: &Field, jac: &Jacobians, sub: usize) -
                 continue;
             }
             for (l, row) in out.iter_mut().enumerate() {
-                row[ox] = read(Some(l));
+                row[ox] = read(Some(l)).max(cut);
             }
         }
     });
@@ -438,9 +546,12 @@ pub fn debris_area(style: &BrushStyle) -> f64 {
 /// query's largest piece is its body and always stays. `field` is the
 /// query's field (or a copy of it), used up.
 fn final_layers_with(style: &BrushStyle, r: &QueryResult, field: Field) -> Vec<(Color, Grid<f32>)> {
-    let field = extend_owned(style, field, border_rings(r));
+    let rings = border_rings(r);
+    let reach = Reach::of(&field.coords, rings);
+    let field = extend_owned(style, field, rings);
     let jac = Jacobians::of(style, &field);
-    let read = read_layers(style, &field, &jac, r.sub);
+    let read = read_layers(style, &field, &jac, r.sub, &reach);
+    drop(reach);
     drop(jac);
     let mut layers: Vec<(Color, Grid<f32>)> =
         style.facts.palette.iter().copied().zip(read).collect();

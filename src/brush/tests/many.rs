@@ -40,12 +40,18 @@ const NEIGHBOURS: [(isize, isize); 8] = [
 ];
 
 /// The documented continuation, ring by ring over the whole canvas from a
-/// copy of the field: the oracle for [`extend_field`].
+/// copy of the field, each continued pixel keeping the covered pixel it
+/// was continued from: the oracle for [`extend_field`].
 fn extend_naive(style: &BrushStyle, field: &Field, rings: usize) -> Field {
     let mut f = field.clone();
     let (w, h) = (f.coords.width(), f.coords.height());
+    // Per pixel, the covered source it was continued from: position,
+    // coordinate, Jacobian, orientation.
+    type From = ((usize, usize), Coord, synth::Jacobian, [f32; 2]);
+    let mut from: Vec<Option<From>> = vec![None; w * h];
     for _ in 0..rings {
         let snap = f.clone();
+        let held = from.clone();
         let mut any = false;
         for y in 0..h {
             for x in 0..w {
@@ -53,36 +59,53 @@ fn extend_naive(style: &BrushStyle, field: &Field, rings: usize) -> Field {
                     continue;
                 }
                 let mut counts: Vec<(u32, usize)> = Vec::new();
-                let mut preds: Vec<(u32, Coord, [f32; 2])> = Vec::new();
+                let mut firsts: Vec<(u32, (usize, usize))> = Vec::new();
                 for (dx, dy) in NEIGHBOURS {
                     let (nx, ny) = (x as isize + dx, y as isize + dy);
                     let Some(c) = snap.coords.get_or(nx, ny, None) else {
                         continue;
                     };
-                    let (nx, ny) = (nx as usize, ny as usize);
-                    let Some(j) = synth::jacobian(style, &snap, nx, ny) else {
-                        continue;
-                    };
-                    let d = synth::apply(j, [-dx as f32, -dy as f32]);
-                    let p = Coord {
+                    match counts.iter_mut().find(|(e, _)| *e == c.exemplar) {
+                        Some(k) => k.1 += 1,
+                        None => {
+                            counts.push((c.exemplar, 1));
+                            firsts.push((c.exemplar, (nx as usize, ny as usize)));
+                        }
+                    }
+                }
+                let top = counts.iter().map(|c| c.1).max().unwrap_or(0);
+                let Some((e, _)) = counts.iter().find(|c| c.1 == top) else {
+                    continue;
+                };
+                let Some(&(_, (nx, ny))) = firsts.iter().find(|p| p.0 == *e) else {
+                    continue;
+                };
+                let src = match held[ny * w + nx] {
+                    Some(s) => s,
+                    None => {
+                        let (Some(c), Some(j)) = (
+                            snap.coords.get(nx, ny),
+                            synth::jacobian(style, &snap, nx, ny),
+                        ) else {
+                            continue;
+                        };
+                        ((nx, ny), c, j, snap.orient.get(nx, ny))
+                    }
+                };
+                let (at, c, j, o) = src;
+                let d = synth::apply(j, [x as f32 - at.0 as f32, y as f32 - at.1 as f32]);
+                f.coords.set(
+                    x,
+                    y,
+                    Some(Coord {
                         exemplar: c.exemplar,
                         x: c.x + d[0],
                         y: c.y + d[1],
-                    };
-                    match counts.iter_mut().find(|(e, _)| *e == c.exemplar) {
-                        Some(k) => k.1 += 1,
-                        None => counts.push((c.exemplar, 1)),
-                    }
-                    preds.push((c.exemplar, p, snap.orient.get(nx, ny)));
-                }
-                let top = counts.iter().map(|c| c.1).max().unwrap_or(0);
-                if let Some((e, _)) = counts.iter().find(|c| c.1 == top) {
-                    if let Some((_, p, o)) = preds.iter().find(|p| p.0 == *e) {
-                        f.coords.set(x, y, Some(*p));
-                        f.orient.set(x, y, *o);
-                        any = true;
-                    }
-                }
+                    }),
+                );
+                f.orient.set(x, y, o);
+                from[y * w + x] = Some(src);
+                any = true;
             }
         }
         if !any {
@@ -157,4 +180,41 @@ fn many_small_strokes_each_trace_as_alone() {
         let alone = trace_query(style, r, g.id.clone(), &TraceOptions::default());
         assert_eq!(&alone, g, "{}", g.id);
     }
+}
+
+#[test]
+fn continued_ink_ends_within_the_continuations_reach() {
+    use crate::brush::output::{border_rings, final_layers};
+    let style = vine();
+    let svg = r#"<svg xmlns="http://www.w3.org/2000/svg" width="200" height="120" viewBox="0 0 200 120"><path d="M20 80 C 60 10, 120 10, 180 70" fill="none" stroke="black" stroke-width="16"/></svg>"#;
+    let sk = crate::read::sketch::parse(svg.as_bytes()).expect("parses");
+    let keep = Settings {
+        discard_fields: false,
+        ..Settings::default()
+    };
+    let out = brush_sketch(style, &sk, &keep).expect("brushes");
+    let r = &out.queries[0];
+    let covered = r.field.coords.map(|c| c.is_some());
+    let dist = crate::raster::edt::squared_edt(&covered).map(f32::sqrt);
+    let k = r.sub.max(1);
+    // The last continued ring less the documented margin, and the cross-
+    // fade of one canvas pixel beyond it.
+    let reach = border_rings(r) as f32 - 1.5 + 1.0;
+    let (mut inked, mut beyond) = (0usize, 0usize);
+    for (_, g) in final_layers(style, r) {
+        for oy in 0..g.height() {
+            for ox in 0..g.width() {
+                if g.get(ox, oy) >= 0.0 {
+                    continue;
+                }
+                inked += 1;
+                let d = dist.get(ox / k, oy / k);
+                if d > reach {
+                    beyond += 1;
+                }
+            }
+        }
+    }
+    assert!(inked > 0);
+    assert_eq!(beyond, 0, "{beyond} of {inked} ink px beyond the reach");
 }
