@@ -1964,7 +1964,9 @@ fn verbose_trace_says_when_a_photos_light_was_evened_out() {
     let o = flourish(&["-v", "trace", s(&photo), "-o", s(&out)]);
     assert!(o.status.success(), "{o:?}");
     let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(err.lines().count(), 1, "{err}");
+    // The note, then the run's peak memory.
+    assert_eq!(err.lines().count(), 2, "{err}");
+    assert!(err.contains("flourish: peak memory "), "{err}");
     assert!(
         err.contains("photo.png") && err.contains("uneven light evened out"),
         "{err}"

@@ -644,19 +644,19 @@ fn check_memory(
 ) -> Result<()> {
     let bb = outline.bounding_box();
     let side = |l: f64| (l * ppu).ceil().clamp(0.0, 1e9) as u64 + 2 * margin as u64;
-    let grid = side(bb.width()).saturating_mul(side(bb.height()));
+    let (gw, gh) = (side(bb.width()), side(bb.height()));
+    let grid = gw.saturating_mul(gh);
+    if gw > region::MAX_FILL_SIDE || gh > region::MAX_FILL_SIDE || grid > region::MAX_FILL_PIXELS {
+        // Over the size limit: the grid's own check says so.
+        return Ok(());
+    }
     let swatches: u64 = which
         .iter()
         .filter_map(|&i| st.tiles.get(i))
         .filter_map(|t| t.layers.first())
         .map(|l| (l.sdf.width() as u64) * (l.sdf.height() as u64))
         .sum();
-    let what = format!(
-        "region {id}: a {}×{} px grid with {} swatch px",
-        side(bb.width()),
-        side(bb.height()),
-        swatches
-    );
+    let what = format!("region {id}: a {gw}×{gh} px grid with {swatches} swatch px");
     crate::memory::check(
         &what,
         grid.saturating_add(swatches).saturating_mul(BYTES_PER_PX),
