@@ -15,19 +15,6 @@ use crate::error::{Error, Result};
 use crate::raster::Grid;
 use kurbo::{Affine, Point, Vec2};
 
-/// Cumulative arc length at each vertex of a polyline.
-fn arc_lengths(pts: &[Point]) -> Vec<f64> {
-    let mut s = Vec::with_capacity(pts.len());
-    let mut acc = 0.0;
-    for (i, p) in pts.iter().enumerate() {
-        if i > 0 {
-            acc += pts[i - 1].distance(*p);
-        }
-        s.push(acc);
-    }
-    s
-}
-
 /// The left-hand normal of a unit tangent (the same convention on both
 /// spines, so left stays left).
 fn normal(t: Vec2) -> Vec2 {
@@ -83,8 +70,14 @@ pub fn art_brush_positions(
     if !(query_width.is_finite() && query_width > 0.0) {
         return bad("the query width must be positive");
     }
-    let (se, te) = (arc_lengths(&spine), tangents(&spine));
-    let (sq, tq) = (arc_lengths(query), tangents(query));
+    let (se, te) = (
+        crate::raster::contour::open_arc_lengths(&spine),
+        tangents(&spine),
+    );
+    let (sq, tq) = (
+        crate::raster::contour::open_arc_lengths(query),
+        tangents(query),
+    );
     let (le, lq) = (se[se.len() - 1], sq[sq.len() - 1]);
     if !(le > 0.0 && lq > 0.0) {
         return bad("a spine has zero length");

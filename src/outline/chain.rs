@@ -32,18 +32,6 @@ pub struct OpenChain {
     pub corners: Vec<usize>,
 }
 
-/// Cumulative arc lengths (px) along an open polyline.
-fn arc_lengths(pts: &[Point]) -> Vec<f64> {
-    let mut cum = Vec::with_capacity(pts.len());
-    let mut s = 0.0;
-    cum.push(0.0);
-    for w in pts.windows(2) {
-        s += (w[1] - w[0]).hypot();
-        cum.push(s);
-    }
-    cum
-}
-
 /// The point at arc length `s` (clamped to the chain).
 fn at(pts: &[Point], cum: &[f64], s: f64) -> Point {
     let n = pts.len();
@@ -86,7 +74,7 @@ pub fn open_chain(points: Vec<Point>) -> OpenChain {
             points: pts,
         };
     }
-    let cum = arc_lengths(&pts);
+    let cum = crate::raster::contour::open_arc_lengths(&pts);
     let total = cum[n - 1];
     let turn: Vec<f64> = (0..n)
         .map(|i| {

@@ -116,6 +116,20 @@ pub fn closed_arc_lengths(points: &[Point]) -> Vec<f64> {
     cum
 }
 
+/// Cumulative arc lengths (px, or the points' units) along an open
+/// polyline: `cum[i]` to vertex `i`, `cum[0] = 0`.
+pub fn open_arc_lengths(points: &[Point]) -> Vec<f64> {
+    let mut cum = Vec::with_capacity(points.len());
+    let mut s = 0.0;
+    for (i, p) in points.iter().enumerate() {
+        if i > 0 {
+            s += (*p - points[i - 1]).hypot();
+        }
+        cum.push(s);
+    }
+    cum
+}
+
 /// `x` brought into `0..period` by adding or subtracting one period: the
 /// same number as `x.rem_euclid(period)` for `x` in `−period..2·period`
 /// (both add exactly `period` below zero, and from `period` up to twice

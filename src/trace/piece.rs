@@ -90,13 +90,7 @@ impl<'a> Piece<'a> {
         corner_start: bool,
         corner_end: bool,
     ) -> Self {
-        let mut cum = Vec::with_capacity(pts.len());
-        let mut s = 0.0;
-        cum.push(0.0);
-        for w in pts.windows(2) {
-            s += (w[1] - w[0]).hypot();
-            cum.push(s);
-        }
+        let cum = crate::raster::contour::open_arc_lengths(&pts);
         let origin = pts.first().map(|p| p.to_vec2()).unwrap_or_default();
         let moments = match guide {
             Guide::Outline(_) => {
