@@ -185,9 +185,10 @@ pub fn pattern<'a>(
     io::set_stage(format!("pattern: {} shapes", sketch.queries.len()));
     let out = in_px(sketch, opts.scale, |sk| {
         let out = pattern::synthesize_sketch(sk, |q| Ok(styles.of(q)?.pattern()?.clone()), opts)?;
+        let document = out.to_document();
         Ok(Output {
-            warnings: out.warnings.clone(),
-            ..Output::new(out.to_document())
+            warnings: out.warnings,
+            ..Output::new(document)
         })
     })?;
     Ok(finish(out))

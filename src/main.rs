@@ -1317,8 +1317,8 @@ mod budget {
         let _ = write!(
             line,
             "out of memory: {} more would pass the memory budget of {}",
-            Mb(asked as u64),
-            Mb(budget)
+            flourish::memory::Size(asked as u64),
+            flourish::memory::Size(budget)
         );
         flourish::io::with_stage(|stage| {
             if !stage.is_empty() {
@@ -1327,20 +1327,6 @@ mod budget {
         });
         let _ = line.write_str(" (--max-memory to change it)\n");
         end(&line.bytes[..line.len])
-    }
-
-    /// A byte count in MB or GB, formatted without allocating.
-    struct Mb(u64);
-
-    impl std::fmt::Display for Mb {
-        fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-            let mb = self.0 as f64 / (1u64 << 20) as f64;
-            if mb >= 1024.0 {
-                write!(f, "{:.1} GB", mb / 1024.0)
-            } else {
-                write!(f, "{mb:.0} MB")
-            }
-        }
     }
 
     #[cfg(unix)]

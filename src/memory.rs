@@ -135,11 +135,23 @@ pub fn check(what: &str, bytes: u64) -> Result<()> {
 
 /// A byte count in MB or GB with one decimal, for messages.
 pub fn in_words(bytes: u64) -> String {
-    let mb = bytes as f64 / (1 << 20) as f64;
-    if mb >= 1024.0 {
-        format!("{:.1} GB", mb / 1024.0)
-    } else {
-        format!("{mb:.0} MB")
+    Size(bytes).to_string()
+}
+
+/// A byte count shown in MB, or in GB with one decimal from 1 GB up;
+/// formatting it allocates nothing (the counting allocator's message
+/// uses it).
+#[derive(Clone, Copy, Debug)]
+pub struct Size(pub u64);
+
+impl std::fmt::Display for Size {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mb = self.0 as f64 / (1u64 << 20) as f64;
+        if mb >= 1024.0 {
+            write!(f, "{:.1} GB", mb / 1024.0)
+        } else {
+            write!(f, "{mb:.0} MB")
+        }
     }
 }
 
