@@ -423,6 +423,17 @@ fn hostile_inputs_end_in_a_valid_output_or_one_line() {
         ));
     }
     let regions = w("regions.svg", svg(&many));
+    // Ten hairlines across the page: their pieces come to more canvas
+    // than a sketch may take.
+    let mut lines = String::new();
+    for k in 0..10 {
+        lines.push_str(&format!(
+            r##"<path d="M0 {} L800 {}" fill="none" stroke="#000" stroke-width="0.1"/>"##,
+            k * 10,
+            500 + k * 10
+        ));
+    }
+    let hairlines = w("hairlines.svg", svg(&lines));
     // A style of 20,000 exemplars, and one whose exemplar is a FIFO.
     let crowd = dir.join("crowd");
     std::fs::create_dir_all(&crowd).expect("a style folder");
@@ -495,6 +506,15 @@ fn hostile_inputs_end_in_a_valid_output_or_one_line() {
             vec!["brush".into(), "--style".into(), "vine".into(), p(&far)],
             p(&far),
         ),
+        (
+            vec![
+                "brush".into(),
+                "--style".into(),
+                "vine".into(),
+                p(&hairlines),
+            ],
+            p(&hairlines),
+        ),
         (vec!["trace".into(), p(&flat)], p(&flat)),
         (
             vec!["fill".into(), "--style".into(), "knot".into(), p(&flat)],
@@ -550,4 +570,39 @@ fn hostile_inputs_end_in_a_valid_output_or_one_line() {
             other => panic!("{args:?}: exit {other:?}: {err}"),
         }
     }
+}
+
+/// A stroke 1 unit wide across the page needs a 6400×4800 px canvas at
+/// 8 px across, past the 16 Mpx one canvas may have: it is brushed in
+/// pieces, under the 2 GiB cap.
+#[test]
+fn a_long_thin_stroke_is_brushed_in_pieces_within_the_budget() {
+    let dir = folder("long-stroke");
+    let sketch = dir.join("long.svg");
+    std::fs::write(
+        &sketch,
+        r##"<svg xmlns="http://www.w3.org/2000/svg" width="800" height="600"><path id="long" d="M10 10 C300 50 500 550 790 590" fill="none" stroke="#000" stroke-width="1"/></svg>"##,
+    )
+    .expect("a sketch");
+    let out = dir.join("out.svg");
+    let (code, err) = capped(
+        &[
+            "brush",
+            "--style",
+            "vine",
+            sketch.to_str().expect("utf-8"),
+            "-o",
+            out.to_str().expect("utf-8"),
+        ],
+        2048,
+        300,
+    );
+    assert_eq!(code, Some(0), "{err}");
+    let bytes = std::fs::read(&out).expect("an output");
+    let tree = resvg::usvg::Tree::from_data(&bytes, &resvg::usvg::Options::default())
+        .expect("a valid output");
+    // The ornament reaches both ends of the stroke.
+    let b = tree.root().abs_bounding_box();
+    assert!(b.left() < 20.0 && b.right() > 780.0, "{b:?}");
+    assert!(b.top() < 20.0 && b.bottom() > 580.0, "{b:?}");
 }

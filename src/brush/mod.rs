@@ -18,6 +18,8 @@
 //! - [`synth`]: §5.4 hierarchical synthesis of exemplar coordinates
 //!   (oriented-neighbourhood correction, coordinate upsampling);
 //! - [`pipeline`]: the stages chained for one query, on its own canvas;
+//! - [`pieces`]: a stroke too long for one canvas, on a chain of canvases
+//!   along its spine;
 //! - [`output`]: per-layer SDFs through the coordinates, traced to one
 //!   `<g>` per query;
 //! - [`baseline`]: the "art brush" reference, one exemplar stretched along
@@ -32,6 +34,7 @@ pub mod maxflow;
 #[cfg(test)]
 pub(crate) mod measure;
 pub mod output;
+pub mod pieces;
 pub mod pipeline;
 pub mod query;
 pub mod ribs;

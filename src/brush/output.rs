@@ -5,6 +5,7 @@
 //! traced to Béziers, one `<g>` per query in drawing order with the
 //! layers' colours, bottom layer first.
 
+use super::pieces::{in_pieces, layout, Layout, MAX_SKETCH_PIXELS};
 use super::pipeline::{as_branch, brush_query, starts_on, to_finest, QueryResult, Settings};
 use super::query::{self, QuerySpine};
 use super::synth::{self, Coord, Field};
@@ -710,6 +711,40 @@ fn refine_one(
     r
 }
 
+/// Refines (when asked) and traces one synthesized query, dropping its
+/// fields when [`Settings::discard_fields`] says so.
+fn finish_query(
+    style: &BrushStyle,
+    r: QueryResult,
+    refine: Option<&resvg::usvg::Tree>,
+    opts: &Settings,
+    trace: &TraceOptions,
+) -> (QueryResult, Group) {
+    let mut r = match refine {
+        Some(tree) => refine_one(style, r, tree, opts),
+        None => r,
+    };
+    let id = if r.spine.query_id.is_empty() {
+        "q".to_string()
+    } else {
+        r.spine.query_id.clone()
+    };
+    let group = if opts.discard_fields {
+        let empty = Field {
+            level: r.field.level,
+            coords: Grid::new(0, 0, None),
+            orient: Grid::new(0, 0, [0.0; 2]),
+            seam: Grid::new(0, 0, false),
+        };
+        let field = std::mem::replace(&mut r.field, empty);
+        r.levels = Vec::new();
+        trace_field(style, &r, field, id, trace)
+    } else {
+        trace_query(style, &r, id, trace)
+    };
+    (r, group)
+}
+
 /// Runs the brush pipeline on every open path of `sketch` (queries in
 /// parallel, results in drawing order) and writes the document. Each query
 /// is synthesized, refined and traced in one go, so with
@@ -719,38 +754,47 @@ pub fn brush_sketch(style: &BrushStyle, sketch: &Sketch, opts: &Settings) -> Res
     let (spines, warnings, notes) = prepared_spines(sketch, opts)?;
     let refine = opts.refine.as_ref().map(|r| &*r.tree);
     let trace = TraceOptions::default();
+    // The cost is stated before any synthesis: the canvases of all the
+    // strokes together.
+    let mut total = 0u64;
+    let mut largest = (0u64, "");
+    for q in &spines {
+        let part = |e: Error| e.in_part(format!("query {}", q.query_id));
+        let px = layout(style, q, opts).map_err(part)?.pixels();
+        total = total.saturating_add(px);
+        if px > largest.0 {
+            largest = (px, &q.query_id);
+        }
+    }
+    if total > MAX_SKETCH_PIXELS {
+        return Err(Error::invalid(format!(
+            "its strokes need {} Mpx of canvas (query {}: {} Mpx), more than the {} Mpx one sketch may take (brush fewer, shorter or wider strokes)",
+            total >> 20,
+            largest.1,
+            largest.0 >> 20,
+            MAX_SKETCH_PIXELS >> 20
+        )));
+    }
     let tally = crate::io::Tally::new("brush: strokes synthesized", spines.len());
-    let done: Vec<(QueryResult, Group)> = spines
+    let done: Vec<Vec<(QueryResult, Group)>> = spines
         .par_iter()
         .map(|q| {
-            let r = brush_query(style, q, opts)
-                .map_err(|e| e.in_part(format!("query {}", q.query_id)))?;
-            let mut r = match &refine {
-                Some(tree) => refine_one(style, r, tree, opts),
-                None => r,
+            let mut out = Vec::new();
+            let mut finish = |r: QueryResult| -> Result<()> {
+                out.push(finish_query(style, r, refine, opts, &trace));
+                Ok(())
             };
-            let id = if r.spine.query_id.is_empty() {
-                "q".to_string()
+            let part = |e: Error| e.in_part(format!("query {}", q.query_id));
+            if let Layout::Whole(_) = layout(style, q, opts).map_err(part)? {
+                finish(brush_query(style, q, opts).map_err(part)?)?;
             } else {
-                r.spine.query_id.clone()
-            };
-            let group = if opts.discard_fields {
-                let empty = Field {
-                    level: r.field.level,
-                    coords: Grid::new(0, 0, None),
-                    orient: Grid::new(0, 0, [0.0; 2]),
-                    seam: Grid::new(0, 0, false),
-                };
-                let field = std::mem::replace(&mut r.field, empty);
-                r.levels = Vec::new();
-                trace_field(style, &r, field, id, &trace)
-            } else {
-                trace_query(style, &r, id, &trace)
-            };
+                in_pieces(style, q, opts, &mut finish).map_err(part)?;
+            }
             tally.tick();
-            Ok((r, group))
+            Ok(out)
         })
         .collect::<Result<Vec<_>>>()?;
+    let done: Vec<(QueryResult, Group)> = done.into_iter().flatten().collect();
     let ppu = done
         .iter()
         .map(|(r, _)| r.out_canvas().px_per_unit)

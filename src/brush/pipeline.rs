@@ -30,10 +30,10 @@
 use super::arap::{rasterize_coords, Arap, RibMesh};
 use super::baseline::art_brush_coords;
 use super::graphcut::{seam, Cover, Label, SeamParams};
-use super::matching::{match_query, MatchOptions, SpineFeatures};
+use super::matching::{match_query, MatchOptions, MatchedSegment, Matching, SpineFeatures};
 use super::query::{QueryOptions, QuerySpine};
 pub use super::ribs::exemplar_width;
-use super::ribs::{exemplar_features, resample_ribs};
+use super::ribs::{exemplar_features, resample_ribs, Resampled};
 use super::synth::{self, Coord, Field, SynthOptions};
 use crate::brush::analysis::BrushStyle;
 use crate::error::{Error, Result};
@@ -74,6 +74,11 @@ pub struct Settings {
     /// synthesized at a time, not of all of them (about 18 MB each for a
     /// 556×556 px canvas). The document is the same either way.
     pub discard_fields: bool,
+    /// Synthesize every query in pieces of at most this many top-level
+    /// canvas pixels ([`super::pieces`]); `None`: only a query whose
+    /// whole canvas does not fit, in pieces of
+    /// [`super::pieces::PIECE_PIXELS`].
+    pub pieces: Option<u64>,
 }
 
 /// A query's canvas, at the synthesis's top level: pixel `(x, y)` has its
@@ -117,6 +122,9 @@ impl Canvas {
     }
 }
 
+/// Matched segments of a query: exemplar index and query sample range.
+pub type Segments = Vec<(usize, std::ops::Range<usize>)>;
+
 /// One query after synthesis.
 #[derive(Clone, Debug)]
 pub struct QueryResult {
@@ -130,7 +138,7 @@ pub struct QueryResult {
     pub field: Field,
     /// Matched segments (exemplar index, query sample range); empty for the
     /// art-brush baseline.
-    pub segments: Vec<(usize, std::ops::Range<usize>)>,
+    pub segments: Segments,
     /// The corrected field of every synthesis level, coarse to fine, when
     /// a refinement will read them (§5.5); else empty.
     pub levels: Vec<Field>,
@@ -233,6 +241,13 @@ pub const MAX_BRUSH_PIXELS: u64 = 16 << 20;
 /// peak (fields of every level, Jacobians, layer SDFs, the traced
 /// output), for the memory budget's estimate.
 pub const BYTES_PER_CANVAS_PX: u64 = 180;
+
+/// Bytes one query may plan for: half the memory budget (two queries
+/// are synthesized at once on two cores; each allocation is still
+/// checked against what is left when it is made).
+pub fn query_share() -> u64 {
+    crate::memory::budget() / 2
+}
 
 /// Largest output grid of one brush query, pixels in all (32 Mpx, about
 /// 30 bytes each: the layers' SDFs and the ink mask); a finer one is not
@@ -600,54 +615,157 @@ fn run_query(
     opts: &Settings,
     stop_at_init: bool,
 ) -> Result<QueryResult> {
-    let levels = style.exemplars.first().map(|e| e.levels.len()).unwrap_or(0);
-    if levels == 0 || q.samples.len() < 2 {
-        return Err(Error::degenerate("brush", "nothing to synthesize"));
-    }
-    let ew = exemplar_width(style)?;
-    let start = opts
-        .start_level
-        .unwrap_or_else(|| start_level(style, ew))
-        .min(levels - 1);
-    let mut top = opts
-        .top_level
-        .unwrap_or_else(|| top_level(style, ew, q.width))
-        .clamp(start, levels - 1);
-    let level_scale = |l: usize| {
-        style
-            .exemplars
-            .first()
-            .and_then(|e| e.levels.get(l))
-            .map_or(1.0, |lv| lv.scale)
-    };
-    // A stroke too long for its canvas at the level the output asks for
-    // is synthesized at a coarser level that fits the size limit and the
-    // memory budget; at the coarsest it is refused with the canvas named.
-    let canvas = loop {
-        let fits = canvas_for(q, ew * level_scale(top), 1 << (top - start)).and_then(|c| {
-            let bytes = (c.width as u64)
-                .saturating_mul(c.height as u64)
-                .saturating_mul(BYTES_PER_CANVAS_PX);
-            let what = format!(
-                "the {}×{} px canvas of query {}",
-                c.width, c.height, q.query_id
-            );
-            crate::memory::check(&what, bytes).map(|()| c)
-        });
-        match fits {
-            Err(_) if top > start => top -= 1,
-            other => break other?,
-        }
-    };
-    // Finest exemplar px per sketch unit, and per canvas px.
-    let fine = ew / q.width;
-    let sub = output_subdivision(style, canvas.px_per_unit, fine);
-    let canvas_px = (canvas.width as u64).saturating_mul(canvas.height as u64);
-    let most = ((MAX_OUT_PIXELS / canvas_px.max(1)) as f64).sqrt().floor() as usize;
-    let sub = sub.min(most.max(1));
+    let plan = Plan::of(style, q, opts)?;
+    let (canvas, top) = plan.whole_canvas(style, q)?;
+    let sub = plan.subdivision(style, q, canvas);
     if opts.art_brush {
         return art_brush(style, q, canvas, top, sub);
     }
+    let (ribs, m) = matched(style, q, opts, plan.ew)?;
+    let (init, segments) = init_field(
+        style,
+        q,
+        plan.start,
+        canvas,
+        &ribs,
+        &m.segments,
+        &opts.seams,
+    )?;
+    if stop_at_init {
+        return Ok(QueryResult {
+            spine: q.clone(),
+            canvas,
+            sub,
+            field: init,
+            segments,
+            levels: Vec::new(),
+        });
+    }
+    let sopts = SynthOptions {
+        seed: opts.seed,
+        ..opts.synth.clone()
+    };
+    let mut levels = synth::synthesize_levels(style, init, top, &sopts);
+    // Only a refinement reads the levels again (the top one included).
+    let field = if opts.refine.is_some() {
+        levels.last().cloned()
+    } else {
+        let top = levels.pop();
+        levels.clear();
+        top
+    }
+    .ok_or_else(|| Error::degenerate("brush", "synthesis produced no level"))?;
+    Ok(QueryResult {
+        spine: q.clone(),
+        canvas,
+        sub,
+        field,
+        segments,
+        levels,
+    })
+}
+
+/// The levels a query is synthesized on: from `start` (the graph cut's)
+/// to `top` (the one the output asks for), `ew` the exemplars' mean width
+/// in finest px.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Plan {
+    /// Level of the graph cut.
+    pub(crate) start: usize,
+    /// Level the output asks for.
+    pub(crate) top: usize,
+    /// Exemplars' mean width, finest px.
+    pub(crate) ew: f64,
+}
+
+impl Plan {
+    /// The plan of `q` under `opts`.
+    pub(crate) fn of(style: &BrushStyle, q: &QuerySpine, opts: &Settings) -> Result<Plan> {
+        let levels = style.exemplars.first().map(|e| e.levels.len()).unwrap_or(0);
+        if levels == 0 || q.samples.len() < 2 {
+            return Err(Error::degenerate("brush", "nothing to synthesize"));
+        }
+        let ew = exemplar_width(style)?;
+        let start = opts
+            .start_level
+            .unwrap_or_else(|| start_level(style, ew))
+            .min(levels - 1);
+        let top = opts
+            .top_level
+            .unwrap_or_else(|| top_level(style, ew, q.width))
+            .clamp(start, levels - 1);
+        Ok(Plan { start, top, ew })
+    }
+
+    /// Stroke width, canvas px, at level `l`.
+    pub(crate) fn width_at(self, style: &BrushStyle, l: usize) -> f64 {
+        let scale = style
+            .exemplars
+            .first()
+            .and_then(|e| e.levels.get(l))
+            .map_or(1.0, |lv| lv.scale);
+        self.ew * scale
+    }
+
+    /// The canvas of the whole query and the level it stops on: a stroke
+    /// too long for its canvas at the level the output asks for is
+    /// synthesized at a coarser level that fits the size limit and
+    /// [`query_share`]; at the start level it is refused with the canvas
+    /// named (then [`super::pieces`] cuts it into pieces). The choice
+    /// depends on the budget, never on what other threads hold, so the
+    /// output is the same at any thread count.
+    pub(crate) fn whole_canvas(
+        self,
+        style: &BrushStyle,
+        q: &QuerySpine,
+    ) -> Result<(Canvas, usize)> {
+        let mut top = self.top;
+        loop {
+            let fits =
+                canvas_for(q, self.width_at(style, top), 1 << (top - self.start)).and_then(|c| {
+                    let bytes = (c.width as u64)
+                        .saturating_mul(c.height as u64)
+                        .saturating_mul(BYTES_PER_CANVAS_PX);
+                    if bytes <= query_share() {
+                        return Ok(c);
+                    }
+                    Err(Error::invalid(format!(
+                        "the {}×{} px canvas of query {} needs about {}, more than the {} one stroke may take (half the memory budget, --max-memory)",
+                        c.width,
+                        c.height,
+                        q.query_id,
+                        crate::memory::in_words(bytes),
+                        crate::memory::in_words(query_share())
+                    )))
+                });
+            match fits {
+                Err(_) if top > self.start => top -= 1,
+                other => return other.map(|c| (c, top)),
+            }
+        }
+    }
+
+    /// The output subdivision of `canvas` ([`output_subdivision`]) under
+    /// [`MAX_OUT_PIXELS`].
+    pub(crate) fn subdivision(self, style: &BrushStyle, q: &QuerySpine, canvas: Canvas) -> usize {
+        // Finest exemplar px per sketch unit.
+        let fine = self.ew / q.width;
+        let sub = output_subdivision(style, canvas.px_per_unit, fine);
+        let canvas_px = (canvas.width as u64).saturating_mul(canvas.height as u64);
+        let most = ((MAX_OUT_PIXELS / canvas_px.max(1)) as f64).sqrt().floor() as usize;
+        sub.min(most.max(1))
+    }
+}
+
+/// The exemplars' ribs resampled at the query's pace and the piecewise
+/// matching of the query against them (§4).
+pub(crate) fn matched(
+    style: &BrushStyle,
+    q: &QuerySpine,
+    opts: &Settings,
+    ew: f64,
+) -> Result<(Vec<Resampled>, Matching)> {
+    let fine = ew / q.width;
     let h = q.spacing * fine;
     // Samples closer than a quarter exemplar pixel: a stroke far wider
     // than it is long, or so short it was sampled below its width's pace.
@@ -681,12 +799,27 @@ fn run_query(
     // The beam keeps the best state of every run length, so a complete
     // segmentation survives to the last sample (no exhaustive retry).
     let m = match_query(&qf, &feats, &mopts)?;
+    Ok((ribs, m))
+}
+
+/// The start-level field of `segs` on `canvas` (§5.2–5.3): each matched
+/// segment's rib mesh deformed by ARAP onto its query samples and
+/// rasterized, then the graph-cut seams between consecutive ones.
+pub(crate) fn init_field(
+    style: &BrushStyle,
+    q: &QuerySpine,
+    start: usize,
+    canvas: Canvas,
+    ribs: &[Resampled],
+    segs: &[MatchedSegment],
+    params: &SeamParams,
+) -> Result<(Field, Segments)> {
     let div = canvas.factor;
     let coarse = canvas.to_pixel(1.0 / div as f64);
     let (cw, ch) = (canvas.width / div, canvas.height / div);
-    let mut fields = Vec::with_capacity(m.segments.len());
-    let mut segments = Vec::with_capacity(m.segments.len());
-    for seg in &m.segments {
+    let mut fields = Vec::with_capacity(segs.len());
+    let mut segments = Vec::with_capacity(segs.len());
+    for seg in segs {
         let r = ribs
             .get(seg.exemplar)
             .ok_or_else(|| Error::degenerate("brush", "matched exemplar out of range"))?;
@@ -717,40 +850,8 @@ fn run_query(
         fields.push(rasterize_patch(seg.exemplar as u32, &mesh, &out, cw, ch)?);
         segments.push((seg.exemplar, seg.query.clone()));
     }
-    let owner = seams(style, start, &fields, (cw, ch), &opts.seams)?;
-    let init = compose(style, start, &fields, &owner);
-    if stop_at_init {
-        return Ok(QueryResult {
-            spine: q.clone(),
-            canvas,
-            sub,
-            field: init,
-            segments,
-            levels: Vec::new(),
-        });
-    }
-    let sopts = SynthOptions {
-        seed: opts.seed,
-        ..opts.synth.clone()
-    };
-    let mut levels = synth::synthesize_levels(style, init, top, &sopts);
-    // Only a refinement reads the levels again (the top one included).
-    let field = if opts.refine.is_some() {
-        levels.last().cloned()
-    } else {
-        let top = levels.pop();
-        levels.clear();
-        top
-    }
-    .ok_or_else(|| Error::degenerate("brush", "synthesis produced no level"))?;
-    Ok(QueryResult {
-        spine: q.clone(),
-        canvas,
-        sub,
-        field,
-        segments,
-        levels,
-    })
+    let owner = seams(style, start, &fields, (cw, ch), params)?;
+    Ok((compose(style, start, &fields, &owner), segments))
 }
 
 /// A synthesized query carried to the finest level, for refinement (§5.5:

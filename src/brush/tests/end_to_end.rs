@@ -333,12 +333,13 @@ fn bad_input_is_refused_or_skipped_clearly() {
     );
     let e = brush_file(&p).unwrap_err().to_string();
     assert!(e.contains("no open paths") && e.contains("skipped"), "{e}");
-    // A huge stroke on a tiny width: the canvas limit, before allocation.
+    // A huge stroke on a tiny width: the sketch's canvas budget, before
+    // any synthesis.
     let (_d, p) = temp_sketch(
         r##"<path d="M0 50 L400000 50" fill="none" stroke="#000" stroke-width="0.5"/>"##,
     );
     let e = brush_file(&p).unwrap_err().to_string();
-    assert!(e.contains("s.svg") && e.contains("size limit"), "{e}");
+    assert!(e.contains("s.svg") && e.contains("Mpx of canvas"), "{e}");
     // An enormous stroke width: refused clearly, nothing huge allocated.
     let (_d, p) = temp_sketch(
         r##"<path d="M40 100 L360 100" fill="none" stroke="#000" stroke-width="1e9"/>"##,
