@@ -67,8 +67,21 @@ pub struct State {
     styles: Mutex<HashMap<String, Style>>,
     /// The newest generation seen per lane.
     lanes: Mutex<HashMap<String, u64>>,
-    /// Free synthesis slots, and the condition to wait for one on.
-    free: (Mutex<usize>, Condvar),
+    /// Synthesis slots handed out first come, first served, and the
+    /// condition to wait for one's turn on.
+    queue: (Mutex<Queue>, Condvar),
+}
+
+/// The tickets of the synthesis queue.
+struct Queue {
+    /// The ticket the next request to arrive takes.
+    next: u64,
+    /// The ticket whose turn it is.
+    turn: u64,
+    /// Syntheses running now.
+    running: usize,
+    /// Most syntheses at once ([`slots`]).
+    slots: usize,
 }
 
 /// Holds a synthesis slot; gives it back when dropped.
@@ -76,10 +89,10 @@ struct Slot<'a>(&'a State);
 
 impl Drop for Slot<'_> {
     fn drop(&mut self) {
-        let (lock, cv) = &self.0.free;
-        if let Ok(mut n) = lock.lock() {
-            *n += 1;
-            cv.notify_one();
+        let (lock, cv) = &self.0.queue;
+        if let Ok(mut q) = lock.lock() {
+            q.running -= 1;
+            cv.notify_all();
         }
     }
 }
@@ -92,7 +105,15 @@ impl State {
             bound,
             styles: Mutex::new(HashMap::new()),
             lanes: Mutex::new(HashMap::new()),
-            free: (Mutex::new(slots()), Condvar::new()),
+            queue: (
+                Mutex::new(Queue {
+                    next: 0,
+                    turn: 0,
+                    running: 0,
+                    slots: slots(),
+                }),
+                Condvar::new(),
+            ),
         }
     }
 
@@ -227,14 +248,19 @@ impl State {
         Ok(named)
     }
 
-    /// Takes a synthesis slot, waiting for one; `None` if the lock broke.
+    /// Takes a synthesis slot, waiting for it in order of arrival (so no
+    /// request waits behind later ones); `None` if the lock broke.
     fn slot(&self) -> Option<Slot<'_>> {
-        let (lock, cv) = &self.free;
-        let mut n = lock.lock().ok()?;
-        while *n == 0 {
-            n = cv.wait(n).ok()?;
+        let (lock, cv) = &self.queue;
+        let mut q = lock.lock().ok()?;
+        let ticket = q.next;
+        q.next += 1;
+        while q.turn != ticket || q.running >= q.slots {
+            q = cv.wait(q).ok()?;
         }
-        *n -= 1;
+        q.turn += 1;
+        q.running += 1;
+        cv.notify_all();
         Some(Slot(self))
     }
 

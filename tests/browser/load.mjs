@@ -65,6 +65,9 @@ let peakRss = 0;
 const sampler = setInterval(() => { peakRss = Math.max(peakRss, memory().rss); }, 500);
 
 async function client(c) {
+  // People do not lift their pens at the same millisecond: each client
+  // starts at its own moment within the first pause.
+  await new Promise((r) => setTimeout(r, (THINK_MS * c) / CLIENTS));
   for (let n = 1; Date.now() < end; n++) {
     const body = JSON.stringify({
       sketch: sketch(c, n).replace('data-style="vine"', `data-style="${styles[c % 3]}"`),
