@@ -342,3 +342,42 @@ fn several_clients_at_once_are_served() {
     }
     assert_ne!(svgs[0], svgs[1]);
 }
+
+#[test]
+fn a_refinement_sketch_is_the_command_lines_refine() {
+    let server = start();
+    let refine = r#"<svg xmlns="http://www.w3.org/2000/svg" width="400" height="240" viewBox="0 0 400 240">
+  <path d="M200 20 L200 120" fill="none" stroke="white" stroke-width="30"/>
+</svg>"#;
+    let req =
+        serde_json::json!({"sketch": STROKES, "mode": "brush", "style": "vine", "refine": refine});
+    let (status, body) = post(&server, "/api/synthesize", req.to_string().as_bytes());
+    assert_eq!(status, 200, "{}", String::from_utf8_lossy(&body));
+    let vine = Library::shipped()
+        .load("vine", &StyleOptions::default())
+        .expect("vine");
+    let sketch = Sketch::from_svg(STROKES.as_bytes()).expect("sketch");
+    let opts = BrushOptions {
+        refine: Some(flourish::Refinement::from_svg(refine.as_bytes()).expect("refine")),
+        ..BrushOptions::default()
+    };
+    let want = flourish::brush(&sketch, &vine, &opts)
+        .expect("brushes")
+        .to_svg();
+    assert_eq!(json(&body)["svg"].as_str(), Some(want.as_str()));
+    for (want, req) in [
+        (
+            400,
+            serde_json::json!({"sketch": SHAPE, "mode": "fill", "style": "knot", "refine": refine}),
+        ),
+        (
+            422,
+            serde_json::json!({"sketch": STROKES, "mode": "brush", "style": "vine", "refine": "<svg"}),
+        ),
+    ] {
+        assert_eq!(
+            post(&server, "/api/synthesize", req.to_string().as_bytes()).0,
+            want
+        );
+    }
+}

@@ -14,6 +14,7 @@ const state = {
   H: 560, // document height, px
   styles: [], // [{name, kind, exemplars}]
   strokes: [], // [{id, mode, style, points: [[x, y, w]], closed, gen, svg, status}]
+  refine: [], // refinement strokes over brush results: [{points: [[x, y, w]], add}]
   history: [], // undo entries: {type: 'add'|'erase'|'seed', ...}
   seed: 0,
   nextId: 1,
@@ -123,18 +124,32 @@ function sketchSvg(strokes) {
 }
 state.sketchSvg = sketchSvg;
 
+/** The refinement sketch (DecoBrush §5.5; the command line's
+ * `--refine`): black strokes add ornament, white ones erase it. */
+function refineSvg() {
+  return `<svg xmlns="http://www.w3.org/2000/svg" width="${state.W}" height="${state.H}" ` +
+    `viewBox="0 0 ${state.W} ${state.H}">\n` +
+    state.refine.map((r) => `  <path d="${pathData({ points: r.points })}" fill="none" ` +
+      `stroke="${r.add ? 'black' : 'white'}" stroke-width="${fmt(meanWidth(r))}" ` +
+      'stroke-linecap="round" stroke-linejoin="round"/>\n').join('') + '</svg>\n';
+}
+state.refineSvg = refineSvg;
+
 /** The request that synthesizes `strokes` as the command line would. */
 function request(strokes, lane, generation) {
   const styles = new Set(strokes.map((s) => s.style));
   const one = styles.size === 1 ? [...styles][0] : null;
-  return {
+  const mode = one ? kindOf(one) : 'decorate';
+  const body = {
     sketch: sketchSvg(strokes),
-    mode: one ? kindOf(one) : 'decorate',
+    mode,
     style: one,
     seed: state.seed,
     lane,
     generation,
   };
+  if (mode === 'brush' && state.refine.length) body.refine = refineSvg();
+  return body;
 }
 state.request = request;
 
@@ -278,7 +293,7 @@ let settleTimer = 0;
 /** The key of the drawing as it is now: the request that synthesizes it. */
 function drawingKey() {
   const r = request(state.strokes);
-  return JSON.stringify([r.sketch, r.mode, r.style, r.seed]);
+  return JSON.stringify([r.sketch, r.mode, r.style, r.seed, r.refine || null]);
 }
 
 /** Forgets the settled drawing (something changed) and shows the strokes. */
@@ -356,9 +371,15 @@ function onDown(e) {
     }
     return;
   }
+  const [x, y] = toDoc(e);
+  if (tool().startsWith('refine')) {
+    drawing = { refine: true, add: tool() === 'refine-add', points: [[x, y, widthAt(e)]] };
+    $('board').setPointerCapture(e.pointerId);
+    updateLive();
+    return;
+  }
   const style = $('style').value;
   if (!style) return;
-  const [x, y] = toDoc(e);
   drawing = {
     id: `s-${state.nextId++}`,
     mode: mode(),
@@ -403,6 +424,14 @@ function onUp(e) {
   let length = 0;
   for (let i = 1; i < p.length; i++) length += Math.hypot(p[i][0] - p[i - 1][0], p[i][1] - p[i - 1][1]);
   if (length < 4 || p.length < (stroke.closed ? 3 : 2)) return;
+  if (stroke.refine) {
+    const item = { points: stroke.points, add: stroke.add };
+    state.refine.push(item);
+    state.history.push({ type: 'refine', item });
+    drawRefine();
+    rerunAll(started);
+    return;
+  }
   state.strokes.push(stroke);
   state.history.push({ type: 'add', stroke });
   redraw();
@@ -427,6 +456,12 @@ function undo() {
     h.stroke.gen = -1;
   } else if (h.type === 'erase') {
     state.strokes.splice(h.index, 0, h.stroke);
+  } else if (h.type === 'refine') {
+    state.refine = state.refine.filter((r) => r !== h.item);
+    drawRefine();
+    rerunAll();
+    status('undone');
+    return;
   } else if (h.type === 'seed') {
     setSeed(h.seed);
     redraw();
@@ -448,9 +483,21 @@ function setSeed(seed) {
   $('seed').textContent = String(seed);
 }
 
-function rerunAll() {
-  const started = performance.now();
-  for (const s of state.strokes) run(s, started);
+function rerunAll(started) {
+  const t = started || performance.now();
+  unsettle();
+  for (const s of state.strokes) run(s, t);
+}
+
+/** Draws the refinement strokes over the board. */
+function drawRefine() {
+  $('refine').replaceChildren(...state.refine.map((r) => {
+    const p = document.createElementNS(SVG_NS, 'path');
+    p.setAttribute('d', pathData({ points: r.points }));
+    p.setAttribute('stroke-width', fmt(meanWidth(r)));
+    p.setAttribute('class', r.add ? 'add' : 'erase');
+    return p;
+  }));
 }
 
 function another() {
@@ -592,6 +639,8 @@ function importSketch(text) {
   fit();
   for (const s of state.strokes) s.gen = -1;
   state.strokes = strokes;
+  state.refine = [];
+  drawRefine();
   state.history = strokes.map((stroke) => ({ type: 'add', stroke }));
   redraw();
   rerunAll();
@@ -630,6 +679,7 @@ function wire() {
   $('zoom-reset').addEventListener('click', fit);
   $('export-result').addEventListener('click', exportResult);
   $('export-sketch').addEventListener('click', () => download('flourish-sketch.svg', sketchSvg()));
+  $('export-refine').addEventListener('click', () => download('flourish-refine.svg', refineSvg()));
   $('import').addEventListener('change', async (e) => {
     const file = e.target.files[0];
     if (!file) return;

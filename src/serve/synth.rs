@@ -7,7 +7,7 @@
 use super::Reply;
 use flourish::{
     BrushOptions, DecorateOptions, Decoration, FillOptions, Library, Output, PatternOptions,
-    QueryKind, Sketch, Style, StyleEntry, StyleKind, StyleOptions, Styles,
+    QueryKind, Refinement, Sketch, Style, StyleEntry, StyleKind, StyleOptions, Styles,
 };
 use serde::Deserialize;
 use serde_json::json;
@@ -48,6 +48,11 @@ struct SynthRequest {
     /// The seed of the command line's `--seed` (default 0).
     #[serde(default)]
     seed: u64,
+    /// A refinement sketch for mode `brush` (DecoBrush §5.5; the command
+    /// line's `--refine`): SVG text of the sketch's size whose black
+    /// strokes add ornament and white ones erase it.
+    #[serde(default)]
+    refine: Option<String>,
     /// What the request draws (a stroke's id): a later generation of the
     /// same lane makes this one stale.
     #[serde(default)]
@@ -333,11 +338,22 @@ impl State {
             self.style(name, Some(kind))
         };
         let seed = req.seed;
+        if req.refine.is_some() && req.mode != "brush" {
+            return Err(Reply::error(400, "refine goes with mode brush only"));
+        }
         match req.mode.as_str() {
             "brush" => {
                 let style = style_of(StyleKind::Brush)?;
+                let refine = match &req.refine {
+                    Some(svg) => Some(
+                        Refinement::from_svg(svg.as_bytes())
+                            .map_err(|e| Reply::error(422, format!("refine: {e}")))?,
+                    ),
+                    None => None,
+                };
                 let opts = BrushOptions {
                     seed,
+                    refine,
                     ..BrushOptions::default()
                 };
                 flourish::brush(sketch, &style, &opts).map_err(fail)

@@ -145,12 +145,19 @@ async function downloaded(button) {
   return readFileSync(path, 'utf8');
 }
 
-/** The command line's output for `sketch` (text) in `mode` with `style`, `seed`. */
-function cli(mode, style, seed, sketch) {
+/** The command line's output for `sketch` (text) in `mode` with `style`,
+ * `seed` (and a refinement sketch, text). */
+function cli(mode, style, seed, sketch, refine) {
   const input = join(work, `cli-${mode}-${style}-${seed}.svg`);
   writeFileSync(input, sketch);
   const output = join(work, `cli-${mode}-${style}-${seed}-out.svg`);
-  execFileSync(bin, [mode, '--quiet', '--style', style, '--seed', String(seed), input, '-o', output]);
+  const args = [mode, '--quiet', '--style', style, '--seed', String(seed), input, '-o', output];
+  if (refine) {
+    const r = join(work, 'cli-refine.svg');
+    writeFileSync(r, refine);
+    args.push('--refine', r);
+  }
+  execFileSync(bin, args);
   return readFileSync(output, 'utf8');
 }
 
@@ -221,6 +228,28 @@ test('erase removes a stroke and undo brings it back; undo removes strokes', { t
   await page.click('#undo');
   assert.equal(await page.evaluate(() => window.flourish.strokes.length), n - 1);
   assert.equal(await page.locator('#results > g').count(), n - 1);
+  await clear();
+});
+
+test('refine strokes add and erase ornament as flourish brush --refine does', { timeout: 120000 }, async () => {
+  await choose('brush', 'vine');
+  await drawPen(wave(80, 720, 280, 40));
+  await settled(0);
+  const plain = await shown();
+  await page.check('input[name=tool][value=refine-erase]');
+  await drawPen([[400, 200], [400, 240], [400, 280], [400, 320], [400, 360]]);
+  await settled(0);
+  const sketch = await downloaded('#export-sketch');
+  const refine = await downloaded('#export-refine');
+  assert.match(refine, /stroke="white"/);
+  const refined = await shown();
+  assert.notEqual(refined, plain, 'the erase stroke changes the ornament');
+  assert.equal(refined, cli('brush', 'vine', 0, sketch, refine));
+  await page.screenshot({ path: join(out, 'serve-refine.png') });
+  await page.click('#undo');
+  await settled(0);
+  assert.equal(await shown(), plain, 'undo takes the refinement back');
+  await page.check('input[name=tool][value=draw]');
   await clear();
 });
 
