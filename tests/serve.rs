@@ -381,3 +381,49 @@ fn a_refinement_sketch_is_the_command_lines_refine() {
         );
     }
 }
+
+#[test]
+fn uploads_become_styles_and_bad_uploads_get_a_4xx() {
+    let server = start();
+    let (status, body) = post(&server, "/api/uploads", b"");
+    assert_eq!(status, 200);
+    let id = json(&body)["id"].as_u64().expect("an id");
+    let files = format!("/api/uploads/{id}/files");
+    // Nothing to make a style of yet; a file that is no drawing.
+    assert_eq!(
+        post(&server, &format!("/api/uploads/{id}/style/pattern"), b"").0,
+        400
+    );
+    assert_eq!(post(&server, &files, b"#!/bin/sh\nrm -rf /\n").0, 415);
+    let example = std::fs::read(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("styles/flowers/example.svg"),
+    )
+    .expect("the flowers example");
+    assert_eq!(post(&server, &files, &example).0, 200);
+    assert_eq!(
+        post(&server, &format!("/api/uploads/{id}/style/paint"), b"").0,
+        400
+    );
+    assert_eq!(post(&server, "/api/uploads/999/files", &example).0, 404);
+    assert_eq!(post(&server, "/api/uploads/x/files", &example).0, 400);
+    let (status, body) = post(&server, &format!("/api/uploads/{id}/style/pattern"), b"");
+    assert_eq!(status, 200, "{}", String::from_utf8_lossy(&body));
+    let made = json(&body);
+    let name = made["name"].as_str().expect("a name").to_string();
+    assert_eq!(made["kind"], "pattern");
+    // Offered and usable like a shipped style.
+    let (_, list) = get(&server, "/api/styles");
+    assert!(json(&list)["styles"]
+        .as_array()
+        .expect("a list")
+        .iter()
+        .any(|s| s["name"] == name.as_str()));
+    assert_eq!(
+        get(&server, &format!("/api/styles/{name}/exemplars/0")).1,
+        example
+    );
+    let sketch = STROKES.replace("data-style=\"vine\" ", "");
+    let req = serde_json::json!({"sketch": sketch, "mode": "pattern", "style": name});
+    let (status, body) = post(&server, "/api/synthesize", req.to_string().as_bytes());
+    assert_eq!(status, 200, "{}", String::from_utf8_lossy(&body));
+}

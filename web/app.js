@@ -83,6 +83,32 @@ function showExemplars() {
   }
 }
 
+/** Makes `files` (dropped or chosen) a style of the current mode on the
+ * server, shows its check's warnings, and picks it. */
+async function ownStyle(files) {
+  const kind = mode();
+  const post = async (url, body) => {
+    const r = await fetch(url, { method: 'POST', body });
+    const reply = await r.json().catch(() => ({ error: `HTTP ${r.status}` }));
+    if (r.status !== 200) throw new Error(reply.error || `HTTP ${r.status}`);
+    return reply;
+  };
+  try {
+    status(`making a ${kind} style of ${files.length} exemplars…`);
+    const { id } = await post('/api/uploads');
+    for (const f of files) await post(`/api/uploads/${id}/files`, f);
+    const made = await post(`/api/uploads/${id}/style/${kind}`);
+    await loadStyles();
+    chosen[kind] = made.name;
+    fillStylePicker();
+    const warn = made.warnings.length ? `: ${made.warnings.join('; ')}` : '';
+    status(`style ${made.name} (${made.kind}, ${made.exemplars} exemplars)${warn}`, warn ? 'warn' : '');
+    state.ownStyles = (state.ownStyles || []).concat([made]);
+  } catch (e) {
+    status(`new style: ${e.message}`, 'error');
+  }
+}
+
 function kindOf(name) {
   const s = state.styles.find((s) => s.name === name);
   return s ? s.kind : null;
@@ -680,6 +706,20 @@ function wire() {
   $('export-result').addEventListener('click', exportResult);
   $('export-sketch').addEventListener('click', () => download('flourish-sketch.svg', sketchSvg()));
   $('export-refine').addEventListener('click', () => download('flourish-refine.svg', refineSvg()));
+  const drop = $('drop');
+  drop.addEventListener('dragover', (e) => { e.preventDefault(); drop.classList.add('over'); });
+  drop.addEventListener('dragleave', () => drop.classList.remove('over'));
+  drop.addEventListener('drop', (e) => {
+    e.preventDefault();
+    drop.classList.remove('over');
+    const files = [...e.dataTransfer.files];
+    if (files.length) ownStyle(files);
+  });
+  $('own').addEventListener('change', (e) => {
+    const files = [...e.target.files];
+    e.target.value = '';
+    if (files.length) ownStyle(files);
+  });
   $('import').addEventListener('change', async (e) => {
     const file = e.target.files[0];
     if (!file) return;

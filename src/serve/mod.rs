@@ -10,6 +10,9 @@
 //! | `GET /api/styles` | every style of the library: name, kind, exemplar count |
 //! | `GET /api/styles/NAME/exemplars/I` | exemplar I of style NAME (SVG or PNG bytes) |
 //! | `POST /api/synthesize` | a sketch, a mode, a style and a seed → the result SVG |
+//! | `POST /api/uploads` | a new upload of exemplars → its id |
+//! | `POST /api/uploads/ID/files` | one exemplar file (SVG, PNG or JPEG) |
+//! | `POST /api/uploads/ID/style/KIND` | the upload made a style `mine-ID` of KIND, with its check's warnings |
 //!
 //! Nothing a client sends is used as a file path: a style is found by
 //! exact name among the styles the library lists, an exemplar by its index
@@ -21,6 +24,7 @@
 //! while it waited is dropped with 409.
 
 mod synth;
+mod upload;
 
 use flourish::Library;
 use std::io::Read;
@@ -196,7 +200,17 @@ fn route(state: &synth::State, request: &mut Request) -> Reply {
             Ok(bytes) => state.synthesize(&bytes),
             Err(reply) => reply,
         },
-        (_, ["api", "styles", ..]) | (_, ["api", "synthesize"]) => {
+        (Method::Post, ["api", "uploads"]) => state.uploads.create(),
+        (Method::Post, ["api", "uploads", id, "files"]) => match (id.parse(), body(request)) {
+            (Ok(id), Ok(bytes)) => state.uploads.add_file(id, &bytes),
+            (Err(_), _) => Reply::error(400, format!("upload id {id:?} is not a number")),
+            (_, Err(reply)) => reply,
+        },
+        (Method::Post, ["api", "uploads", id, "style", kind]) => match id.parse() {
+            Ok(id) => state.make_style(id, kind),
+            Err(_) => Reply::error(400, format!("upload id {id:?} is not a number")),
+        },
+        (_, ["api", "styles", ..]) | (_, ["api", "synthesize"]) | (_, ["api", "uploads", ..]) => {
             Reply::error(405, format!("{path}: wrong method"))
         }
         _ => Reply::error(404, format!("{path}: no such page")),

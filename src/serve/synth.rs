@@ -72,6 +72,10 @@ pub struct State {
     styles: Mutex<HashMap<String, Style>>,
     /// The newest generation seen per lane.
     lanes: Mutex<HashMap<String, u64>>,
+    /// Styles made on the page from dropped exemplars.
+    pub uploads: super::upload::Uploads,
+    /// The listing entries of those styles, in the order they were made.
+    made: Mutex<Vec<serde_json::Value>>,
     /// Synthesis slots handed out first come, first served, and the
     /// condition to wait for one's turn on.
     queue: (Mutex<Queue>, Condvar),
@@ -110,6 +114,8 @@ impl State {
             bound,
             styles: Mutex::new(HashMap::new()),
             lanes: Mutex::new(HashMap::new()),
+            uploads: super::upload::Uploads::new(),
+            made: Mutex::new(Vec::new()),
             queue: (
                 Mutex::new(Queue {
                     next: 0,
@@ -147,9 +153,10 @@ impl State {
             .any(|name| host == format!("{name}:{port}"))
     }
 
-    /// The library's styles as JSON: name, kind and exemplar count each.
+    /// The library's styles as JSON: name, kind and exemplar count each;
+    /// then the styles made on the page.
     pub fn styles(&self) -> Reply {
-        let list: Vec<_> = self
+        let mut list: Vec<_> = self
             .library
             .styles()
             .into_iter()
@@ -162,6 +169,9 @@ impl State {
                 }))
             })
             .collect();
+        if let Ok(made) = self.made.lock() {
+            list.extend(made.iter().cloned());
+        }
         Reply::json(200, &json!({ "styles": list }))
     }
 
@@ -190,6 +200,29 @@ impl State {
                 body,
             },
             Err(e) => Reply::error(500, format!("style {name}: exemplar {index}: {e}")),
+        }
+    }
+
+    /// `POST /api/uploads/ID/style/KIND`: makes upload ID a style named
+    /// `mine-ID`, offered from then on like the library's.
+    pub fn make_style(&self, id: u64, kind: &str) -> Reply {
+        let name = format!("mine-{id}");
+        match self.uploads.make_style(id, kind, &name) {
+            Ok((style, reply)) => {
+                if let Ok(mut m) = self.styles.lock() {
+                    m.insert(name.clone(), style.clone());
+                }
+                if let Ok(mut made) = self.made.lock() {
+                    made.retain(|e| e["name"] != name.as_str());
+                    made.push(json!({
+                        "name": name,
+                        "kind": style.kind().name(),
+                        "exemplars": style.files().len().saturating_sub(1),
+                    }));
+                }
+                reply
+            }
+            Err(reply) => reply,
         }
     }
 

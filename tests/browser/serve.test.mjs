@@ -12,7 +12,7 @@
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { spawn, execFileSync } from 'node:child_process';
-import { mkdtempSync, writeFileSync, readFileSync, existsSync, mkdirSync, rmSync } from 'node:fs';
+import { mkdtempSync, writeFileSync, readFileSync, existsSync, mkdirSync, rmSync, readdirSync, copyFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, dirname, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -295,6 +295,37 @@ test('an imported sketch is synthesized and exports as it came in', { timeout: 1
   assert.equal(shapes(again), shapes(sketch));
   assert.equal(await downloaded('#export-result'), cli('brush', 'scroll', 0, again));
   assert.equal(shapes(await downloaded('#export-result')), shapes(result));
+  await clear();
+});
+
+test('dropped exemplars become a brush style that brushes as the command line does', { timeout: 180000 }, async () => {
+  // Three of the shipped vine exemplars, as a designer's own drawings.
+  const src = join(root, 'styles/vine');
+  const names = readdirSync(src).filter((n) => n.endsWith('.svg')).sort().slice(0, 3);
+  await page.check('input[name=mode][value=brush]');
+  await page.setInputFiles('#own', names.map((n) => ({
+    name: n, mimeType: 'image/svg+xml', buffer: readFileSync(join(src, n)),
+  })));
+  await page.waitForFunction(() => (window.flourish.ownStyles || []).length === 1, null, { timeout: 120000 });
+  const made = await page.evaluate(() => window.flourish.ownStyles[0]);
+  assert.equal(made.kind, 'brush');
+  assert.equal(made.exemplars, 3);
+  assert.equal(await page.inputValue('#style'), made.name);
+  assert.equal(await page.locator('#exemplars img').count(), 3);
+  await drawPen(wave(100, 700, 280, 40));
+  await settled(0);
+  const sketch = await downloaded('#export-sketch');
+  // The same drawings made a style by the command line.
+  const dir = join(work, 'own-style');
+  mkdirSync(dir, { recursive: true });
+  names.forEach((n, i) => copyFileSync(join(src, n), join(dir, `exemplar-0${i + 1}.svg`)));
+  execFileSync(bin, ['style', 'init', '--quiet', dir]);
+  const input = join(work, 'own-sketch.svg');
+  writeFileSync(input, sketch);
+  const output = join(work, 'own-out.svg');
+  execFileSync(bin, ['brush', '--quiet', '--style', dir, '--seed', '0', input, '-o', output]);
+  assert.equal(await shown(), readFileSync(output, 'utf8'));
+  await page.screenshot({ path: join(out, 'serve-own-style.png') });
   await clear();
 });
 
