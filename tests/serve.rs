@@ -427,3 +427,30 @@ fn uploads_become_styles_and_bad_uploads_get_a_4xx() {
     let (status, body) = post(&server, "/api/synthesize", req.to_string().as_bytes());
     assert_eq!(status, 200, "{}", String::from_utf8_lossy(&body));
 }
+
+#[test]
+fn a_made_style_downloads_as_a_zip_of_its_folder() {
+    let server = start();
+    let (_, body) = post(&server, "/api/uploads", b"");
+    let id = json(&body)["id"].as_u64().expect("an id");
+    assert_eq!(get(&server, &format!("/api/uploads/{id}/zip")).0, 409);
+    assert_eq!(get(&server, "/api/uploads/999/zip").0, 404);
+    let example = std::fs::read(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("styles/flowers/example.svg"),
+    )
+    .expect("the flowers example");
+    post(&server, &format!("/api/uploads/{id}/files"), &example);
+    post(&server, &format!("/api/uploads/{id}/style/pattern"), b"");
+    let (status, zip) = get(&server, &format!("/api/uploads/{id}/zip"));
+    assert_eq!(status, 200);
+    assert!(zip.starts_with(b"PK\x03\x04"));
+    // Its folder and files are named, in order.
+    let text = String::from_utf8_lossy(&zip);
+    let a = text
+        .find(&format!("mine-{id}/exemplar-01.svg"))
+        .expect("the exemplar");
+    let b = text
+        .find(&format!("mine-{id}/style.toml"))
+        .expect("style.toml");
+    assert!(a < b);
+}

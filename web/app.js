@@ -74,6 +74,14 @@ function showExemplars() {
   const style = state.styles.find((s) => s.name === name);
   const aside = $('exemplars');
   aside.replaceChildren();
+  // A style made here can be taken home as a style folder.
+  const own = /^mine-(\d+)$/.exec(name || '');
+  const link = $('download-style');
+  link.hidden = !own;
+  if (own) {
+    link.href = `/api/uploads/${own[1]}/zip`;
+    link.download = `${name}.zip`;
+  }
   if (!style) return;
   for (let i = 0; i < style.exemplars; i++) {
     const img = document.createElement('img');

@@ -13,6 +13,7 @@
 //! | `POST /api/uploads` | a new upload of exemplars → its id |
 //! | `POST /api/uploads/ID/files` | one exemplar file (SVG, PNG or JPEG) |
 //! | `POST /api/uploads/ID/style/KIND` | the upload made a style `mine-ID` of KIND, with its check's warnings |
+//! | `GET /api/uploads/ID/zip` | that style as a zip of its folder |
 //!
 //! Nothing a client sends is used as a file path: a style is found by
 //! exact name among the styles the library lists, an exemplar by its index
@@ -201,6 +202,10 @@ fn route(state: &synth::State, request: &mut Request) -> Reply {
             Err(reply) => reply,
         },
         (Method::Post, ["api", "uploads"]) => state.uploads.create(),
+        (Method::Get, ["api", "uploads", id, "zip"]) => match id.parse() {
+            Ok(id) => state.uploads.zip(id),
+            Err(_) => Reply::error(400, format!("upload id {id:?} is not a number")),
+        },
         (Method::Post, ["api", "uploads", id, "files"]) => match (id.parse(), body(request)) {
             (Ok(id), Ok(bytes)) => state.uploads.add_file(id, &bytes),
             (Err(_), _) => Reply::error(400, format!("upload id {id:?} is not a number")),

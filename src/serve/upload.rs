@@ -102,6 +102,30 @@ impl Uploads {
         }
     }
 
+    /// `GET /api/uploads/ID/zip`: the style made of upload ID as a zip of
+    /// a folder `mine-ID/` (its `style.toml` and exemplars), ready for
+    /// `flourish --styles`.
+    pub fn zip(&self, id: u64) -> Reply {
+        let dir = match self.drafts.lock() {
+            Ok(d) => match d.0.get(&id) {
+                Some(draft) => draft.dir.clone(),
+                None => return Reply::error(404, format!("no upload {id}")),
+            },
+            Err(_) => return Reply::error(500, "uploads are unavailable"),
+        };
+        if !dir.join("style.toml").is_file() {
+            return Reply::error(409, format!("upload {id} is not a style yet"));
+        }
+        match zip_folder(&dir, &format!("mine-{id}")) {
+            Ok(body) => Reply {
+                status: 200,
+                content_type: "application/zip",
+                body,
+            },
+            Err(e) => Reply::error(500, format!("upload {id}: {e}")),
+        }
+    }
+
     /// `POST /api/uploads/ID/style?kind=K`: makes the draft a style of
     /// kind K: its `style.toml` written, the style loaded and checked.
     /// Returns the style (to be offered as `name`) and the reply.
@@ -187,4 +211,28 @@ impl Uploads {
         );
         Ok((style, reply))
     }
+}
+
+/// The regular files of `dir` (not its subfolders), deflated into a zip
+/// under folder `name/`, in file-name order.
+fn zip_folder(dir: &std::path::Path, name: &str) -> std::io::Result<Vec<u8>> {
+    use std::io::Write;
+    let mut files: Vec<(String, PathBuf)> = std::fs::read_dir(dir)?
+        .filter_map(|e| {
+            let e = e.ok()?;
+            let meta = e.metadata().ok()?;
+            (meta.is_file()).then(|| (e.file_name().into_string().ok(), e.path()))
+        })
+        .filter_map(|(n, p)| Some((n?, p)))
+        .collect();
+    files.sort();
+    let mut zip = zip::ZipWriter::new(std::io::Cursor::new(Vec::new()));
+    let opts = zip::write::SimpleFileOptions::default()
+        .compression_method(zip::CompressionMethod::Deflated);
+    for (file, path) in files {
+        zip.start_file(format!("{name}/{file}"), opts)
+            .map_err(std::io::Error::other)?;
+        zip.write_all(&std::fs::read(path)?)?;
+    }
+    Ok(zip.finish().map_err(std::io::Error::other)?.into_inner())
 }

@@ -326,6 +326,15 @@ test('dropped exemplars become a brush style that brushes as the command line do
   execFileSync(bin, ['brush', '--quiet', '--style', dir, '--seed', '0', input, '-o', output]);
   assert.equal(await shown(), readFileSync(output, 'utf8'));
   await page.screenshot({ path: join(out, 'serve-own-style.png') });
+  // Downloaded as a style folder, it brushes the same from the command line.
+  const [d] = await Promise.all([page.waitForEvent('download'), page.click('#download-style')]);
+  const zipPath = join(work, d.suggestedFilename());
+  await d.saveAs(zipPath);
+  const unpacked = join(work, 'unzipped');
+  execFileSync('python3', ['-m', 'zipfile', '-e', zipPath, unpacked]);
+  const output2 = join(work, 'own-out-2.svg');
+  execFileSync(bin, ['brush', '--quiet', '--styles', unpacked, '--style', made.name, '--seed', '0', input, '-o', output2]);
+  assert.equal(readFileSync(output2, 'utf8'), readFileSync(output, 'utf8'));
   await clear();
 });
 
