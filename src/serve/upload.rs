@@ -31,27 +31,31 @@ struct Draft {
 
 /// The drafts and the private folder holding them.
 pub struct Uploads {
-    /// The private temporary folder (owner-only), removed on a clean exit.
-    root: Option<tempfile::TempDir>,
+    /// The private temporary folder (owner-only), made on the first
+    /// upload (`None` inside when it could not be made).
+    root: std::sync::OnceLock<Option<tempfile::TempDir>>,
     /// Drafts by id, and the next id.
     drafts: Mutex<(HashMap<u64, Draft>, u64)>,
 }
 
 impl Uploads {
-    /// An empty set of drafts; the folder is made on the first upload.
+    /// An empty set of drafts.
     pub fn new() -> Uploads {
         Uploads {
-            root: tempfile::Builder::new()
-                .prefix("flourish-serve-")
-                .tempdir()
-                .ok(),
+            root: std::sync::OnceLock::new(),
             drafts: Mutex::new((HashMap::new(), 1)),
         }
     }
 
     /// `POST /api/uploads`: a new draft; its id.
     pub fn create(&self) -> Reply {
-        let Some(root) = &self.root else {
+        let root = self.root.get_or_init(|| {
+            tempfile::Builder::new()
+                .prefix("flourish-serve-")
+                .tempdir()
+                .ok()
+        });
+        let Some(root) = root else {
             return Reply::error(507, "no temporary folder for uploads");
         };
         let Ok(mut d) = self.drafts.lock() else {
