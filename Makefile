@@ -3,7 +3,7 @@ CARGO ?= cargo
 BIN := target/release/flourish
 OUT := out
 
-.PHONY: demo test gallery golden bench lint deps clean fuzz-smoke corpus
+.PHONY: demo test gallery golden bench lint deps clean fuzz-smoke corpus browser-deps browser-test serve load-test
 
 # Everything the tests need that cargo does not install: potrace, the
 # reference tracer the trace tests compare against (Debian package).
@@ -53,9 +53,41 @@ demo:
 # The whole test suite, built once with the test profile (optimized: see
 # [profile.test]); the examples' binaries are built too, for
 # tests/examples.rs.
-test: deps
+test: deps browser-deps
 	$(CARGO) build --profile test --workspace --all-targets
 	$(CARGO) test --workspace --tests
+	$(MAKE) browser-test
+
+# What the browser tests of `flourish serve` need: Debian's chromium and
+# node, and playwright-core from npm at the version package-lock.json pins.
+browser-deps:
+	@command -v npm >/dev/null 2>&1 || \
+	  (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq nodejs npm) || \
+	  { echo "make: install the Debian packages nodejs and npm" >&2; exit 1; }
+	@[ -x /usr/bin/chromium ] || \
+	  (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium) || \
+	  { echo "make: install the Debian package chromium" >&2; exit 1; }
+	cd tests/browser && npm ci --no-audit --no-fund --loglevel=error
+
+# The page of `flourish serve` in headless chromium (tests/browser/): pen
+# strokes, results against the command line, undo, another one, erase,
+# fill, import and export, a malformed request; prints the latencies.
+# UPDATE_SCREENSHOTS=1 rewrites docs/serve-*.png.
+browser-test: browser-deps
+	$(CARGO) build --profile test --bin flourish
+	cd tests/browser && FLOURISH_BIN=$(CURDIR)/target/debug/flourish npm test
+
+# 20 clients drawing brush strokes at once for 30 s against `flourish
+# serve` on the loopback interface: fails on an error, a request over 5 s
+# or a peak resident memory over 2 GB; prints latencies and memory.
+load-test:
+	$(CARGO) build --release --bin flourish
+	node tests/browser/load.mjs
+
+# The painting page on http://127.0.0.1:8080/ (release build).
+serve:
+	$(CARGO) build --release --bin flourish
+	$(BIN) serve
 
 # Every mode on the third-party art of ../shared/art (and the shipped
 # styles), measured against each issue's thresholds, with contact sheets

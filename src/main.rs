@@ -12,6 +12,8 @@ use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+mod serve;
+
 #[derive(Parser)]
 #[command(
     name = "flourish",
@@ -55,6 +57,24 @@ enum Command {
     Diff(DiffArgs),
     /// Style libraries: analyse, report and draw diagnostics.
     Style(StyleArgs),
+    /// Paint ornament live in a browser page: serve the page and its API locally.
+    Serve(ServeArgs),
+}
+
+#[derive(Args)]
+struct ServeArgs {
+    /// Port to listen on (0: any free port; the address is printed).
+    #[arg(long, default_value_t = 8080)]
+    port: u16,
+    /// Address to listen on (default: this machine only).
+    #[arg(long, default_value = "127.0.0.1")]
+    host: std::net::IpAddr,
+    /// A folder of styles offered first (then $FLOURISH_STYLES and the shipped styles).
+    #[arg(long, value_name = "DIR")]
+    styles: Option<PathBuf>,
+    /// Open the page in the desktop's browser.
+    #[arg(long)]
+    open: bool,
 }
 
 #[derive(Args)]
@@ -431,6 +451,13 @@ fn run(cli: Cli) -> Result<(), Failure> {
         Command::Style(StyleArgs {
             command: StyleCommand::Init(args),
         }) => run_style_init(args, cli.quiet),
+        Command::Serve(args) => serve::serve(serve::ServeOptions {
+            host: args.host,
+            port: args.port,
+            library: library(&args.styles),
+            open: args.open,
+        })
+        .map_err(|e| Failure::Run(Error::invalid(e))),
     }
 }
 
