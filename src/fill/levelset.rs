@@ -113,8 +113,12 @@ pub fn step(phi: &mut Grid<f32>, target: &Grid<f32>, weight: &Grid<f32>, ev: &Ev
 
 /// Replaces `phi` by the signed distance to its zero level (pixel units,
 /// negative inside): sub-pixel contours of `Φ`, exact distances to them
-/// within `sdf::BAND`, within half a pixel beyond. A field without a zero
-/// level keeps its sign, clamped to the grid's diagonal.
+/// within `sdf::BAND`, within half a pixel beyond, except where the
+/// nearest zero level is its closure along the canvas border (no pixel
+/// beyond the border marks the other side): there beyond the band it is
+/// the distance to the nearest pixel of the other side, which can be
+/// larger. A field without a zero level keeps its sign, clamped to the
+/// grid's diagonal.
 pub fn reinitialize(phi: &mut Grid<f32>) {
     let mut segments = Vec::new();
     for c in contour::extract(phi) {
@@ -137,6 +141,7 @@ pub fn reinitialize(phi: &mut Grid<f32>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::raster::sdf::{BAND, MIN_INSIDE};
 
     fn circle(n: usize, r: f32) -> Grid<f32> {
         let c = n as f32 / 2.0;
@@ -194,6 +199,63 @@ mod tests {
             evolve(&mut phi, &target, &one, &ev);
         }
         assert!((radius(&phi) - 12.0).abs() < 0.3, "{}", radius(&phi));
+    }
+
+    /// Reinitialization against brute force: the distance from every pixel
+    /// centre to every contour segment of a random field's zero level
+    /// (kept off the canvas border, where the contour is closed along the
+    /// border and no pixel beyond it holds the other side).
+    #[test]
+    fn reinitialization_matches_brute_force_distances() {
+        for seed in 0..4u64 {
+            let (w, h) = (37, 29);
+            // A smooth random field: a few random discs, at least 2 px
+            // from the border.
+            let bumps: Vec<[f32; 3]> = (0..6)
+                .map(|i| {
+                    let r = |k: u64| crate::rng::unit(&[seed, i, k]) as f32;
+                    let at = |k: u64, n: usize| 8.0 + r(k) * (n as f32 - 16.0);
+                    [at(0, w), at(1, h), 2.0 + 4.0 * r(2)]
+                })
+                .collect();
+            let mut phi = Grid::from_fn(w, h, |x, y| {
+                let (px, py) = (x as f32 + 0.5, y as f32 + 0.5);
+                bumps
+                    .iter()
+                    .map(|b| (px - b[0]).hypot(py - b[1]) - b[2])
+                    .fold(f32::INFINITY, f32::min)
+            });
+            let before = phi.clone();
+            let segments: Vec<Line> = contour::extract(&phi)
+                .iter()
+                .flat_map(|c| {
+                    let n = c.points.len();
+                    (0..n).map(move |i| Line::new(c.points[i], c.points[(i + 1) % n]))
+                })
+                .collect();
+            reinitialize(&mut phi);
+            for y in 0..h {
+                for x in 0..w {
+                    let p = kurbo::Point::new(x as f64 + 0.5, y as f64 + 0.5);
+                    let exact = segments
+                        .iter()
+                        .map(|l| crate::raster::sdf::point_segment_distance(p, *l))
+                        .fold(f64::INFINITY, f64::min) as f32;
+                    let got = phi.get(x, y);
+                    assert_eq!(got < 0.0, before.get(x, y) < 0.0, "sign at ({x}, {y})");
+                    // Ink stays ink: a centre on the contour keeps MIN_INSIDE.
+                    let want = if got < 0.0 {
+                        exact.max(MIN_INSIDE)
+                    } else {
+                        exact
+                    };
+                    let err = got.abs() - want;
+                    // Exact within the SDF's band, within half a pixel beyond.
+                    let tol = if exact <= BAND { 1e-4 } else { 0.5 };
+                    assert!(err.abs() < tol, "({x}, {y}): {got} vs {exact}");
+                }
+            }
+        }
     }
 
     #[test]
