@@ -417,6 +417,23 @@ impl Image {
     }
 }
 
+impl Image {
+    /// Reads a raster drawing of lines (pen or pencil, scanned or
+    /// photographed) for centerline tracing: [`trace()`] then gives open
+    /// stroked paths along the lines' centres, `stroke-width` each line's
+    /// measured width or `stroke_width` px when given.
+    pub fn lines_from_bytes(
+        bytes: &[u8],
+        opts: &ImageOptions,
+        stroke_width: Option<f64>,
+    ) -> Result<Image> {
+        io::set_stage("reading the picture");
+        Ok(Image {
+            picture: read::ink::Traceable::Lines(read::ink::read_lines(bytes, opts, stroke_width)?),
+        })
+    }
+}
+
 /// Traces a picture's ink into compact filled Bézier outlines, one
 /// `<g id="layer-N">` per ink layer: a raster's outline is smoothed as
 /// potrace reads a bitmap (Selinger 2003) or read to a fraction of a pixel

@@ -272,6 +272,14 @@ struct TraceArgs {
     /// nothing overlaps and no seam shows (cutting plotters, embroidery).
     #[arg(long, requires = "layers", conflicts_with = "invert")]
     cutout: bool,
+    /// Trace a drawing of lines along their centres: open stroked paths,
+    /// crossings continued straight through, as wide as the lines.
+    #[arg(long, conflicts_with_all = ["layers", "invert"])]
+    centerline: bool,
+    /// With --centerline: every stroke this wide instead of its line's
+    /// measured width, in pixels.
+    #[arg(long, requires = "centerline", value_name = "PX")]
+    width: Option<f64>,
 }
 
 #[derive(Args)]
@@ -448,7 +456,9 @@ fn run_trace(args: TraceArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
     input.validate()?;
     let job = |inp: &Path| -> Result<String, Error> {
         let bytes = io::read_input(inp)?;
-        let image = if args.cutout {
+        let image = if args.centerline {
+            Image::lines_from_bytes(&bytes, &input, args.width)
+        } else if args.cutout {
             Image::regions_from_bytes(&bytes, &input)
         } else {
             Image::from_bytes(&bytes, &input)
