@@ -2073,3 +2073,48 @@ fn invert_traces_the_paper_as_black_ink() {
         assert!(!svg.contains("fill=\"#fff"), "{sample}: white ink");
     }
 }
+
+/// `trace --centerline`: a drawn cross becomes two stroked open paths of
+/// the drawn width (or `--width`); an SVG is refused with one line.
+#[test]
+fn trace_centerline_gives_stroked_paths() {
+    let dir = tempdir();
+    let png = dir.path().join("cross.png");
+    // Two 4 px bars crossing at the centre of a 120×120 page.
+    render_gray(120, 120, 4, |x, y| {
+        ((y - 60.0).abs() <= 2.0 && (15.0..=105.0).contains(&x))
+            || ((x - 60.0).abs() <= 2.0 && (15.0..=105.0).contains(&y))
+    })
+    .save(&png)
+    .expect("write PNG");
+    let out = dir.path().join("cross.svg");
+    let o = flourish(&["trace", "--centerline", s(&png), "-o", s(&out)]);
+    assert_eq!(code(&o), Some(0), "stderr: {}", stderr(&o));
+    let svg = std::fs::read_to_string(&out).unwrap();
+    assert_eq!(svg.matches("<path").count(), 2, "{svg}");
+    assert_eq!(svg.matches("fill=\"none\"").count(), 2, "{svg}");
+    assert!(svg.contains("stroke-width=\"4"), "{svg}");
+    parse_output(svg.as_bytes()).expect("output parses");
+
+    let o = flourish(&[
+        "trace",
+        "--centerline",
+        "--width",
+        "2.5",
+        s(&png),
+        "-o",
+        s(&out),
+    ]);
+    assert_eq!(code(&o), Some(0), "stderr: {}", stderr(&o));
+    let svg = std::fs::read_to_string(&out).unwrap();
+    assert_eq!(svg.matches("stroke-width=\"2.5\"").count(), 2, "{svg}");
+
+    let sketch = dir.path().join("lines.svg");
+    std::fs::write(
+        &sketch,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="10" height="10"><path d="M1 1L9 9" stroke="black"/></svg>"#,
+    )
+    .unwrap();
+    let o = flourish(&["trace", "--centerline", s(&sketch), "-o", s(&out)]);
+    assert_failure(&o, &sketch, &["raster"]);
+}
