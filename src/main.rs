@@ -198,6 +198,9 @@ struct BrushArgs {
     /// Correction iterations per synthesis level, 0..=100 (0: graph cut upsampled only).
     #[arg(long, default_value_t = 1, value_name = "N")]
     iterations: usize,
+    /// For a PNG or JPEG drawing: every traced line this wide, in pixels.
+    #[arg(long, value_name = "PX")]
+    width: Option<f64>,
 }
 
 #[derive(Args)]
@@ -222,6 +225,9 @@ struct PatternArgs {
     /// Draw the elements and their spacing this many times larger, 0.01..=100.
     #[arg(long, default_value_t = 1.0, value_name = "F")]
     scale: f64,
+    /// For a PNG or JPEG drawing: every traced line this wide, in pixels.
+    #[arg(long, value_name = "PX")]
+    width: Option<f64>,
 }
 
 #[derive(Args)]
@@ -491,7 +497,17 @@ fn report(inp: &Path, out: Output, quiet: bool, verbose: bool) -> String {
 /// Reads a sketch and reports what it skipped: warnings unless `quiet`,
 /// notes under `verbose`.
 fn load_sketch(path: &Path, quiet: bool, verbose: bool) -> Result<Sketch, Error> {
-    let sk = read_sketch(path)?;
+    load_drawn(path, None, quiet, verbose)
+}
+
+/// [`load_sketch`], a raster drawing's lines `width` px wide when given.
+fn load_drawn(
+    path: &Path,
+    width: Option<f64>,
+    quiet: bool,
+    verbose: bool,
+) -> Result<Sketch, Error> {
+    let sk = read_drawn(path, width)?;
     let path = shown(path);
     if !quiet {
         for w in &sk.warnings {
@@ -507,8 +523,21 @@ fn load_sketch(path: &Path, quiet: bool, verbose: bool) -> Result<Sketch, Error>
 }
 
 /// Reads and parses a sketch file (`-`: standard input); errors name it.
+/// A raster drawing's lines, traced along their centres, are its
+/// queries.
 fn read_sketch(path: &Path) -> Result<Sketch, Error> {
-    Sketch::from_svg(&io::read_input(path)?).map_err(|e| e.in_file(shown(path)))
+    read_drawn(path, None)
+}
+
+/// [`read_sketch`], a raster drawing's lines `width` px wide when given.
+fn read_drawn(path: &Path, width: Option<f64>) -> Result<Sketch, Error> {
+    let bytes = io::read_input(path)?;
+    if flourish::looks_like_svg(&bytes) {
+        Sketch::from_svg(&bytes)
+    } else {
+        flourish::sketch_from_drawing(&bytes, width)
+    }
+    .map_err(|e| e.in_file(shown(path)))
 }
 
 /// How an input is named in messages: `-` as `<stdin>`.
@@ -558,7 +587,7 @@ fn run_pattern(args: PatternArgs, quiet: bool, verbose: bool) -> Result<(), Fail
     };
     let style = lib.load(&args.style, &load)?;
     let job = |sketch: &Path| -> Result<String, Error> {
-        let sk = load_sketch(sketch, quiet, verbose)?;
+        let sk = load_drawn(sketch, args.width, quiet, verbose)?;
         let out = lib
             .load_named(&sk, StyleKind::Pattern, &load)
             .and_then(|named| flourish::pattern(&sk, Styles::new(&style, &named), &opts))
@@ -654,7 +683,7 @@ fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
             measure: verbose,
         };
         let job = |sketch: &Path| -> Result<String, Error> {
-            let sk = load_sketch(sketch, quiet, verbose)?;
+            let sk = load_drawn(sketch, args.width, quiet, verbose)?;
             let out = flourish::brush(&sk, &style, &opts).map_err(|e| e.in_file(shown(sketch)))?;
             let out = kept(out, &sk, args.keep_sketch);
             Ok(report(sketch, out, quiet, verbose))

@@ -2118,3 +2118,32 @@ fn trace_centerline_gives_stroked_paths() {
     let o = flourish(&["trace", "--centerline", s(&sketch), "-o", s(&out)]);
     assert_failure(&o, &sketch, &["raster"]);
 }
+
+/// `pattern` and `brush` take a PNG drawing: its lines, traced along their
+/// centres, are the queries; blank paper fails with one line.
+#[test]
+fn pattern_and_brush_accept_a_png_drawing() {
+    let dir = tempdir();
+    let png = dir.path().join("drawn.png");
+    render_gray(160, 120, 4, |x, y| {
+        (y - 60.0 - 20.0 * (x / 25.0).sin()).abs() <= 2.0 && (15.0..=145.0).contains(&x)
+    })
+    .save(&png)
+    .expect("write PNG");
+    let out = dir.path().join("out.svg");
+    let o = flourish(&["pattern", s(&png), "-o", s(&out)]);
+    assert_eq!(code(&o), Some(0), "stderr: {}", stderr(&o));
+    let svg = std::fs::read_to_string(&out).unwrap();
+    assert!(svg.contains("<g id=\"q-1\""), "{svg}");
+    let o = flourish(&["brush", "--width", "16", s(&png), "-o", s(&out)]);
+    assert_eq!(code(&o), Some(0), "stderr: {}", stderr(&o));
+    let svg = std::fs::read_to_string(&out).unwrap();
+    assert!(svg.contains("<g id=\"q-1\""), "{svg}");
+
+    let blank = dir.path().join("blank.png");
+    render_gray(80, 60, 1, |_, _| false)
+        .save(&blank)
+        .expect("write PNG");
+    let o = flourish(&["pattern", s(&blank), "-o", s(&out)]);
+    assert_failure(&o, &blank, &["no lines"]);
+}
