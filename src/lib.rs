@@ -417,6 +417,57 @@ impl Image {
     }
 }
 
+impl Image {
+    /// Reads a raster drawing of lines (pen or pencil, scanned or
+    /// photographed) for centerline tracing: [`trace()`] then gives open
+    /// stroked paths along the lines' centres, `stroke-width` each line's
+    /// measured width or `stroke_width` px when given.
+    pub fn lines_from_bytes(
+        bytes: &[u8],
+        opts: &ImageOptions,
+        stroke_width: Option<f64>,
+    ) -> Result<Image> {
+        io::set_stage("reading the picture");
+        Ok(Image {
+            picture: read::ink::Traceable::Lines(read::ink::read_lines(bytes, opts, stroke_width)?),
+        })
+    }
+}
+
+/// Whether `bytes` look like SVG (or SVGZ) text rather than a raster.
+pub fn looks_like_svg(bytes: &[u8]) -> bool {
+    read::ink::looks_like_svg(bytes)
+}
+
+/// Reads a raster drawing (PNG, JPEG, …; a pen or pencil drawing, scanned
+/// or photographed) as a sketch: its lines traced along their centres
+/// ([`Image::lines_from_bytes`]) become open stroked path queries, each as
+/// wide as its line or `stroke_width` px. A drawing with no lines (blank
+/// paper) is an error.
+pub fn sketch_from_drawing(bytes: &[u8], stroke_width: Option<f64>) -> Result<Sketch> {
+    let ink = read::ink::read_lines(bytes, &ImageOptions::default(), stroke_width)?;
+    let opts = TraceOptions::default();
+    let strokes = trace::centerline::trace_lines(
+        &ink.coverage,
+        ink.stroke_width,
+        opts.tolerance,
+        opts.min_area,
+    );
+    if strokes.is_empty() {
+        return Err(Error::Invalid(
+            "no lines found in the drawing (blank paper?)".into(),
+        ));
+    }
+    let (w, h) = (ink.coverage.width() as f64, ink.coverage.height() as f64);
+    let mut sketch = Sketch::from_strokes(
+        w,
+        h,
+        strokes.into_iter().map(|s| (s.path, s.width)).collect(),
+    );
+    sketch.notes = ink.notes;
+    Ok(sketch)
+}
+
 /// Traces a picture's ink into compact filled Bézier outlines, one
 /// `<g id="layer-N">` per ink layer: a raster's outline is smoothed as
 /// potrace reads a bitmap (Selinger 2003) or read to a fraction of a pixel

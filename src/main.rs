@@ -218,6 +218,9 @@ struct BrushArgs {
     /// Correction iterations per synthesis level, 0..=100 (0: graph cut upsampled only).
     #[arg(long, default_value_t = 1, value_name = "N")]
     iterations: usize,
+    /// For a PNG or JPEG drawing: every traced line this wide, in pixels.
+    #[arg(long, value_name = "PX")]
+    width: Option<f64>,
 }
 
 #[derive(Args)]
@@ -242,6 +245,9 @@ struct PatternArgs {
     /// Draw the elements and their spacing this many times larger, 0.01..=100.
     #[arg(long, default_value_t = 1.0, value_name = "F")]
     scale: f64,
+    /// For a PNG or JPEG drawing: every traced line this wide, in pixels.
+    #[arg(long, value_name = "PX")]
+    width: Option<f64>,
 }
 
 #[derive(Args)]
@@ -292,6 +298,14 @@ struct TraceArgs {
     /// nothing overlaps and no seam shows (cutting plotters, embroidery).
     #[arg(long, requires = "layers", conflicts_with = "invert")]
     cutout: bool,
+    /// Trace a drawing of lines along their centres: open stroked paths,
+    /// crossings continued straight through, as wide as the lines.
+    #[arg(long, conflicts_with_all = ["layers", "invert"])]
+    centerline: bool,
+    /// With --centerline: every stroke this wide instead of its line's
+    /// measured width, in pixels.
+    #[arg(long, requires = "centerline", value_name = "PX")]
+    width: Option<f64>,
 }
 
 #[derive(Args)]
@@ -475,7 +489,9 @@ fn run_trace(args: TraceArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
     input.validate()?;
     let job = |inp: &Path| -> Result<String, Error> {
         let bytes = io::read_input(inp)?;
-        let image = if args.cutout {
+        let image = if args.centerline {
+            Image::lines_from_bytes(&bytes, &input, args.width)
+        } else if args.cutout {
             Image::regions_from_bytes(&bytes, &input)
         } else {
             Image::from_bytes(&bytes, &input)
@@ -508,7 +524,17 @@ fn report(inp: &Path, out: Output, quiet: bool, verbose: bool) -> String {
 /// Reads a sketch and reports what it skipped: warnings unless `quiet`,
 /// notes under `verbose`.
 fn load_sketch(path: &Path, quiet: bool, verbose: bool) -> Result<Sketch, Error> {
-    let sk = read_sketch(path)?;
+    load_drawn(path, None, quiet, verbose)
+}
+
+/// [`load_sketch`], a raster drawing's lines `width` px wide when given.
+fn load_drawn(
+    path: &Path,
+    width: Option<f64>,
+    quiet: bool,
+    verbose: bool,
+) -> Result<Sketch, Error> {
+    let sk = read_drawn(path, width)?;
     let path = shown(path);
     if !quiet {
         for w in &sk.warnings {
@@ -524,8 +550,21 @@ fn load_sketch(path: &Path, quiet: bool, verbose: bool) -> Result<Sketch, Error>
 }
 
 /// Reads and parses a sketch file (`-`: standard input); errors name it.
+/// A raster drawing's lines, traced along their centres, are its
+/// queries.
 fn read_sketch(path: &Path) -> Result<Sketch, Error> {
-    Sketch::from_svg(&io::read_input(path)?).map_err(|e| e.in_file(shown(path)))
+    read_drawn(path, None)
+}
+
+/// [`read_sketch`], a raster drawing's lines `width` px wide when given.
+fn read_drawn(path: &Path, width: Option<f64>) -> Result<Sketch, Error> {
+    let bytes = io::read_input(path)?;
+    if flourish::looks_like_svg(&bytes) {
+        Sketch::from_svg(&bytes)
+    } else {
+        flourish::sketch_from_drawing(&bytes, width)
+    }
+    .map_err(|e| e.in_file(shown(path)))
 }
 
 /// How an input is named in messages: `-` as `<stdin>`.
@@ -575,7 +614,7 @@ fn run_pattern(args: PatternArgs, quiet: bool, verbose: bool) -> Result<(), Fail
     };
     let style = lib.load(&args.style, &load)?;
     let job = |sketch: &Path| -> Result<String, Error> {
-        let sk = load_sketch(sketch, quiet, verbose)?;
+        let sk = load_drawn(sketch, args.width, quiet, verbose)?;
         let out = lib
             .load_named(&sk, StyleKind::Pattern, &load)
             .and_then(|named| flourish::pattern(&sk, Styles::new(&style, &named), &opts))
@@ -671,7 +710,7 @@ fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
             measure: verbose,
         };
         let job = |sketch: &Path| -> Result<String, Error> {
-            let sk = load_sketch(sketch, quiet, verbose)?;
+            let sk = load_drawn(sketch, args.width, quiet, verbose)?;
             let out = flourish::brush(&sk, &style, &opts).map_err(|e| e.in_file(shown(sketch)))?;
             let out = kept(out, &sk, args.keep_sketch);
             Ok(report(sketch, out, quiet, verbose))

@@ -2074,3 +2074,77 @@ fn invert_traces_the_paper_as_black_ink() {
         assert!(!svg.contains("fill=\"#fff"), "{sample}: white ink");
     }
 }
+
+/// `trace --centerline`: a drawn cross becomes two stroked open paths of
+/// the drawn width (or `--width`); an SVG is refused with one line.
+#[test]
+fn trace_centerline_gives_stroked_paths() {
+    let dir = tempdir();
+    let png = dir.path().join("cross.png");
+    // Two 4 px bars crossing at the centre of a 120×120 page.
+    render_gray(120, 120, 4, |x, y| {
+        ((y - 60.0).abs() <= 2.0 && (15.0..=105.0).contains(&x))
+            || ((x - 60.0).abs() <= 2.0 && (15.0..=105.0).contains(&y))
+    })
+    .save(&png)
+    .expect("write PNG");
+    let out = dir.path().join("cross.svg");
+    let o = flourish(&["trace", "--centerline", s(&png), "-o", s(&out)]);
+    assert_eq!(code(&o), Some(0), "stderr: {}", stderr(&o));
+    let svg = std::fs::read_to_string(&out).unwrap();
+    assert_eq!(svg.matches("<path").count(), 2, "{svg}");
+    assert_eq!(svg.matches("fill=\"none\"").count(), 2, "{svg}");
+    assert!(svg.contains("stroke-width=\"4"), "{svg}");
+    parse_output(svg.as_bytes()).expect("output parses");
+
+    let o = flourish(&[
+        "trace",
+        "--centerline",
+        "--width",
+        "2.5",
+        s(&png),
+        "-o",
+        s(&out),
+    ]);
+    assert_eq!(code(&o), Some(0), "stderr: {}", stderr(&o));
+    let svg = std::fs::read_to_string(&out).unwrap();
+    assert_eq!(svg.matches("stroke-width=\"2.5\"").count(), 2, "{svg}");
+
+    let sketch = dir.path().join("lines.svg");
+    std::fs::write(
+        &sketch,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="10" height="10"><path d="M1 1L9 9" stroke="black"/></svg>"#,
+    )
+    .unwrap();
+    let o = flourish(&["trace", "--centerline", s(&sketch), "-o", s(&out)]);
+    assert_failure(&o, &sketch, &["raster"]);
+}
+
+/// `pattern` and `brush` take a PNG drawing: its lines, traced along their
+/// centres, are the queries; blank paper fails with one line.
+#[test]
+fn pattern_and_brush_accept_a_png_drawing() {
+    let dir = tempdir();
+    let png = dir.path().join("drawn.png");
+    render_gray(160, 120, 4, |x, y| {
+        (y - 60.0 - 20.0 * (x / 25.0).sin()).abs() <= 2.0 && (15.0..=145.0).contains(&x)
+    })
+    .save(&png)
+    .expect("write PNG");
+    let out = dir.path().join("out.svg");
+    let o = flourish(&["pattern", s(&png), "-o", s(&out)]);
+    assert_eq!(code(&o), Some(0), "stderr: {}", stderr(&o));
+    let svg = std::fs::read_to_string(&out).unwrap();
+    assert!(svg.contains("<g id=\"q-1\""), "{svg}");
+    let o = flourish(&["brush", "--width", "16", s(&png), "-o", s(&out)]);
+    assert_eq!(code(&o), Some(0), "stderr: {}", stderr(&o));
+    let svg = std::fs::read_to_string(&out).unwrap();
+    assert!(svg.contains("<g id=\"q-1\""), "{svg}");
+
+    let blank = dir.path().join("blank.png");
+    render_gray(80, 60, 1, |_, _| false)
+        .save(&blank)
+        .expect("write PNG");
+    let o = flourish(&["pattern", s(&blank), "-o", s(&out)]);
+    assert_failure(&o, &blank, &["no lines"]);
+}

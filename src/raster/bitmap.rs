@@ -3,7 +3,6 @@
 //! ([`crate::outline::paths`]) are walked on.
 
 use super::Coverage;
-#[cfg(test)]
 use super::Grid;
 use rayon::prelude::*;
 
@@ -82,7 +81,6 @@ impl Bitmap {
     }
 
     /// Whether pixel (x, y) is ink; pixels outside the bitmap are paper.
-    #[cfg(test)]
     pub fn ink(&self, x: isize, y: isize) -> bool {
         let (w, h) = (self.width as isize, self.height as isize);
         if x < -1 || y < -1 || x > w || y > h {
@@ -104,7 +102,6 @@ impl Bitmap {
     }
 
     /// As coverage: 1 for ink, 0 for paper.
-    #[cfg(test)]
     pub fn to_coverage(&self) -> Coverage {
         Grid::from_fn(self.width, self.height, |x, y| {
             if self.ink(x as isize, y as isize) {

@@ -91,6 +91,69 @@ pub enum Traceable {
     Outline(OutlineInk),
     /// A picture as regions of its colours, the paper's too.
     Regions(RegionInk),
+    /// A drawing of lines, to be traced along their centres.
+    Lines(LineInk),
+}
+
+/// A raster drawing read as one layer of ink coverage, for tracing the
+/// centres of its lines ([`crate::trace::centerline`]).
+#[derive(Clone, Debug)]
+pub struct LineInk {
+    /// The ink's coverage (0 paper … 1 ink), one sample per pixel.
+    pub coverage: crate::raster::Coverage,
+    /// The ink's colour.
+    pub color: Color,
+    /// Stroke width (px) given by the caller, or `None` to measure each
+    /// line's.
+    pub stroke_width: Option<f64>,
+    /// What was done to the picture on the way (a photo's light evened
+    /// out), one line each.
+    pub notes: Vec<String>,
+}
+
+/// Reads raster bytes as a drawing of lines: all ink as one layer of
+/// coverage (the darkest of the colour layers where a picture has
+/// several), with a photo's uneven light divided out first. `stroke_width`
+/// (px) is kept for the tracer. SVG input is refused: its lines are
+/// already vectors.
+pub fn read_lines(bytes: &[u8], opts: &ImageOptions, stroke_width: Option<f64>) -> Result<LineInk> {
+    if looks_like_svg(bytes) {
+        return Err(Error::Invalid(
+            "centerline tracing reads a raster drawing (PNG, JPEG, …), not an SVG".into(),
+        ));
+    }
+    if let Some(w) = stroke_width {
+        if !(w.is_finite() && w > 0.0 && w <= 1000.0) {
+            return Err(Error::Option {
+                name: "width",
+                reason: format!("{w} px is not in (0, 1000]"),
+            });
+        }
+    }
+    let opts = ImageOptions {
+        layers: false,
+        ..opts.clone()
+    };
+    let (coverage, lighting) = raster_coverage(bytes, &opts)?;
+    let (coverage, color) = match coverage {
+        RasterCoverage::Binary { color, bits, .. } => (bits.to_coverage(), color),
+        RasterCoverage::Layers { w, h, layers } => {
+            let color = layers.last().map_or(Color::BLACK, |l| l.0);
+            let mut all = crate::raster::Grid::new(w, h, 0.0f32);
+            for (_, cov) in &layers {
+                for (a, &c) in all.data_mut().iter_mut().zip(cov.data()) {
+                    *a = a.max(c);
+                }
+            }
+            (all, color)
+        }
+    };
+    Ok(LineInk {
+        coverage,
+        color,
+        stroke_width,
+        notes: lighting.iter().map(|l| l.note()).collect(),
+    })
 }
 
 /// A picture read as regions of its colours ([`crate::raster::regions`]).

@@ -113,6 +113,31 @@ impl Sketch {
         parse(bytes)
     }
 
+    /// A sketch made in code of open stroked paths (`spine`, `width` in
+    /// px) on a `width`×`height` px page, queries `q-1`, `q-2`, … in
+    /// order, no styles named.
+    pub fn from_strokes(width: f64, height: f64, strokes: Vec<(BezPath, f64)>) -> Sketch {
+        Sketch {
+            width,
+            height,
+            view_box: Rect::new(0.0, 0.0, width, height),
+            queries: strokes
+                .into_iter()
+                .enumerate()
+                .map(|(i, (spine, width))| Query {
+                    id: format!("q-{}", i + 1),
+                    style: None,
+                    kind: QueryKind::Path { spine, width },
+                })
+                .collect(),
+            exemplars: BTreeMap::new(),
+            notes: Vec::new(),
+            warnings: Vec::new(),
+            backdrop: None,
+            text_left_out: None,
+        }
+    }
+
     /// CSS pixels per user unit: how large the sketch's units are drawn
     /// (3.78 for a sketch in millimetres, 1.33 in points, 1 in px). The
     /// mean of the two axes' scales when its aspect is not kept.

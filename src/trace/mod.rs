@@ -24,6 +24,7 @@
 //! DecoBrush (§7, "Vectorization from SDF") left this step to Illustrator;
 //! flourish measures it against potrace (`make bench`).
 
+pub mod centerline;
 pub mod cover;
 pub mod cutout;
 mod direct;
@@ -31,6 +32,8 @@ pub mod fit;
 mod nearest;
 mod piece;
 mod span;
+#[cfg(test)]
+mod tests_centerline;
 
 use crate::error::{Error, Result};
 use crate::outline::corridor::Corridor;
@@ -389,6 +392,37 @@ pub fn trace(picture: &Traceable, opts: &TraceOptions) -> Result<Output> {
                 document: doc,
                 warnings: Vec::new(),
                 notes: r.notes.clone(),
+            })
+        }
+        Traceable::Lines(l) => {
+            let (w, h) = (l.coverage.width(), l.coverage.height());
+            let mut doc = Document::new(w as f64, h as f64, decimals_for(opts.tolerance));
+            let strokes =
+                centerline::trace_lines(&l.coverage, l.stroke_width, opts.tolerance, opts.min_area);
+            if !strokes.is_empty() {
+                doc.groups.push(Group {
+                    id: "layer-1".into(),
+                    shapes: strokes
+                        .into_iter()
+                        .map(|s| Shape {
+                            path: s.path,
+                            fill: None,
+                            fill_rule: FillRule::NonZero,
+                            stroke: Some(crate::svg_out::Stroke {
+                                color: l.color,
+                                width: s.width,
+                                cap: crate::svg_out::LineCap::Round,
+                                join: crate::svg_out::LineJoin::Round,
+                            }),
+                            opacity: 1.0,
+                        })
+                        .collect(),
+                });
+            }
+            Ok(Output {
+                document: doc,
+                warnings: Vec::new(),
+                notes: l.notes.clone(),
             })
         }
         Traceable::Outline(o) => {
