@@ -10,58 +10,8 @@
 
 use crate::raster::Grid;
 
-/// The 8 neighbours in the order P2…P9 of Zhang & Suen (clockwise from
-/// north).
-const RING: [(isize, isize); 8] = [
-    (0, -1),
-    (1, -1),
-    (1, 0),
-    (1, 1),
-    (0, 1),
-    (-1, 1),
-    (-1, 0),
-    (-1, -1),
-];
-
-/// The one-pixel skeleton of `ink` by Zhang–Suen thinning (two sub-passes
-/// per iteration, each deleting the boundary pixels whose removal keeps
-/// the 8-connected topology, until nothing changes). Pixels outside the
-/// grid count as paper.
-pub fn skeleton(ink: &Grid<bool>) -> Grid<bool> {
-    let (w, h) = (ink.width(), ink.height());
-    let mut g = ink.clone();
-    loop {
-        let mut changed = false;
-        for pass in 0..2 {
-            let mut del = Vec::new();
-            for y in 0..h {
-                for x in 0..w {
-                    if !g.get(x, y) {
-                        continue;
-                    }
-                    let p = ring(&g, x, y);
-                    let b = p.iter().filter(|&&v| v).count();
-                    let a = (0..8).filter(|&i| !p[i] && p[(i + 1) % 8]).count();
-                    let (c1, c2) = if pass == 0 {
-                        (p[0] && p[2] && p[4], p[2] && p[4] && p[6])
-                    } else {
-                        (p[0] && p[2] && p[6], p[0] && p[4] && p[6])
-                    };
-                    if (2..=6).contains(&b) && a == 1 && !c1 && !c2 {
-                        del.push((x, y));
-                    }
-                }
-            }
-            changed |= !del.is_empty();
-            for (x, y) in del {
-                g.set(x, y, false);
-            }
-        }
-        if !changed {
-            return g;
-        }
-    }
-}
+pub use crate::raster::skeleton::skeleton;
+use crate::raster::skeleton::RING;
 
 /// The 8 neighbours of `(x, y)` (P2…P9), outside the grid false.
 fn ring(g: &Grid<bool>, x: usize, y: usize) -> [bool; 8] {

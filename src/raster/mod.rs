@@ -9,6 +9,7 @@ pub mod plain;
 pub mod regions;
 pub mod scan;
 pub mod sdf;
+pub mod skeleton;
 pub mod vector;
 
 pub use sdf::Sdf;

@@ -18,6 +18,7 @@
 use super::cover::fit_open;
 use crate::outline::chain::open_chain;
 use crate::raster::edt::squared_edt;
+use crate::raster::skeleton::{skeleton, RING as NEIGHBOURS};
 use crate::raster::{Coverage, Grid};
 use kurbo::{BezPath, Point, Vec2};
 
@@ -113,7 +114,10 @@ pub fn centerlines(cov: &Coverage, min_area: f64) -> Vec<Line> {
     let small = (w0 * w0).max(2.0);
     clean_components(&mut ink, w, h, false, small);
     clean_components(&mut ink, w, h, true, small.max(min_area));
-    let skel = thin(&ink, w, h);
+    let skel = match Grid::from_vec(w, h, ink) {
+        Some(g) => skeleton(&g).data().to_vec(),
+        None => return Vec::new(),
+    };
     let mut g = Graph::from_skeleton(&skel, w, h);
     let width_of = |pts: &[Point]| median(line_widths(cov, pts, w0));
     let all: Vec<Point> = g.edges.iter().flat_map(|e| e.pts.clone()).collect();
@@ -220,67 +224,6 @@ fn clean_components(mask: &mut [bool], w: usize, h: usize, ink: bool, small: f64
             for &i in &comp {
                 mask[i] = !ink;
             }
-        }
-    }
-}
-
-/// The 8 neighbour offsets, clockwise from north: N, NE, E, SE, S, SW, W,
-/// NW.
-const NEIGHBOURS: [(isize, isize); 8] = [
-    (0, -1),
-    (1, -1),
-    (1, 0),
-    (1, 1),
-    (0, 1),
-    (-1, 1),
-    (-1, 0),
-    (-1, -1),
-];
-
-/// Zhang–Suen thinning of `ink` to an 8-connected skeleton one pixel
-/// wide: border pixels whose removal keeps the neighbourhood connected
-/// (one 0→1 transition around them, 2–6 ink neighbours) are removed in
-/// alternating south-east and north-west passes until none is.
-fn thin(ink: &[bool], w: usize, h: usize) -> Vec<bool> {
-    let mut s = ink.to_vec();
-    let mut live: Vec<usize> = (0..w * h).filter(|&i| s[i]).collect();
-    let at = |s: &[bool], x: isize, y: isize| {
-        x >= 0 && y >= 0 && x < w as isize && y < h as isize && s[y as usize * w + x as usize]
-    };
-    let mut gone = Vec::new();
-    loop {
-        let mut changed = false;
-        for pass in 0..2 {
-            gone.clear();
-            for &i in &live {
-                let (x, y) = ((i % w) as isize, (i / w) as isize);
-                let p: [bool; 8] = NEIGHBOURS.map(|(dx, dy)| at(&s, x + dx, y + dy));
-                let b = p.iter().filter(|&&v| v).count();
-                if !(2..=6).contains(&b) {
-                    continue;
-                }
-                let a = (0..8).filter(|&k| !p[k] && p[(k + 1) % 8]).count();
-                if a != 1 {
-                    continue;
-                }
-                // p[0] N, p[2] E, p[4] S, p[6] W.
-                let keep = if pass == 0 {
-                    p[2] && p[4] && (p[0] || p[6])
-                } else {
-                    p[0] && p[6] && (p[2] || p[4])
-                };
-                if !keep {
-                    gone.push(i);
-                }
-            }
-            for &i in &gone {
-                s[i] = false;
-            }
-            changed |= !gone.is_empty();
-            live.retain(|&i| s[i]);
-        }
-        if !changed {
-            return s;
         }
     }
 }
