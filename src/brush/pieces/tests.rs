@@ -4,24 +4,12 @@
 //! a sketch past the budget is refused before any synthesis.
 
 use super::{MAX_SKETCH_PIXELS, PIECE_PIXELS};
-use crate::brush::analysis::{AnalysisOptions, BrushStyle};
+use crate::brush::analysis::BrushStyle;
 use crate::brush::measure::{at, ink};
 use crate::brush::output::brush_sketch;
 use crate::brush::pipeline::{QueryResult, Settings};
+use crate::brush::tests::vine;
 use std::path::PathBuf;
-use std::sync::OnceLock;
-
-fn vine() -> &'static BrushStyle {
-    static STYLE: OnceLock<BrushStyle> = OnceLock::new();
-    STYLE.get_or_init(|| {
-        let opts = AnalysisOptions {
-            cache_dir: Some(std::env::temp_dir().join("flourish-test-cache")),
-            ..AnalysisOptions::default()
-        };
-        let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-        BrushStyle::load(&root.join("styles/vine"), &opts).expect("style loads")
-    })
-}
 
 fn s_curve() -> crate::read::sketch::Sketch {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));

@@ -3,29 +3,13 @@
 //! around its ornament, and both give what the per-query, whole-canvas
 //! reading gives.
 
-use crate::brush::analysis::{AnalysisOptions, BrushStyle};
+use super::vine;
+use crate::brush::analysis::BrushStyle;
 use crate::brush::output::{brush_sketch, extend_field, trace_query};
 use crate::brush::pipeline::Settings;
 use crate::brush::synth::{self, Coord, Field};
 use crate::raster::Grid;
 use crate::trace::TraceOptions;
-use std::path::PathBuf;
-use std::sync::OnceLock;
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn vine() -> &'static BrushStyle {
-    static STYLE: OnceLock<BrushStyle> = OnceLock::new();
-    STYLE.get_or_init(|| {
-        let opts = AnalysisOptions {
-            cache_dir: Some(std::env::temp_dir().join("flourish-test-cache")),
-            ..AnalysisOptions::default()
-        };
-        BrushStyle::load(&root().join("styles/vine"), &opts).expect("style loads")
-    })
-}
 
 /// The 8-neighbour offsets in scan order (as the output stage reads them).
 const NEIGHBOURS: [(isize, isize); 8] = [

@@ -5,3 +5,20 @@
 mod end_to_end;
 mod many;
 mod stages;
+
+use crate::brush::analysis::{AnalysisOptions, BrushStyle};
+use std::sync::OnceLock;
+
+/// The shipped vine style, analysed once per test run (cache in the
+/// temporary folder).
+pub(crate) fn vine() -> &'static BrushStyle {
+    static STYLE: OnceLock<BrushStyle> = OnceLock::new();
+    STYLE.get_or_init(|| {
+        let opts = AnalysisOptions {
+            cache_dir: Some(std::env::temp_dir().join("flourish-test-cache")),
+            ..AnalysisOptions::default()
+        };
+        let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+        BrushStyle::load(&root.join("styles/vine"), &opts).expect("style loads")
+    })
+}
