@@ -8,7 +8,7 @@
 // FLOURISH_BIN names the binary (default target/release/flourish, else
 // target/debug/flourish).
 
-import { spawn } from 'node:child_process';
+import { startServer } from './server.mjs';
 import { existsSync, readFileSync } from 'node:fs';
 import { join, dirname, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -27,16 +27,9 @@ if (!bin) {
   process.exit(1);
 }
 
-const server = spawn(bin, ['serve', '--port', '0'], { stdio: ['ignore', 'pipe', 'inherit'] });
-const url = await new Promise((ok, fail) => {
-  let text = '';
-  server.stdout.on('data', (b) => {
-    text += b;
-    const m = /(http:\/\/\S+\/)/.exec(text);
-    if (m) ok(m[1]);
-  });
-  server.on('exit', (code) => fail(new Error(`flourish serve exited with ${code}`)));
-});
+const started = startServer(bin);
+const server = started.server;
+const url = await started.url;
 
 /** Resident memory of the server now and at its peak, in KB. */
 function memory() {

@@ -11,7 +11,8 @@
 
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawn, execFileSync } from 'node:child_process';
+import { execFileSync } from 'node:child_process';
+import { startServer } from './server.mjs';
 import { mkdtempSync, writeFileSync, readFileSync, existsSync, mkdirSync, rmSync, readdirSync, copyFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, dirname, resolve } from 'node:path';
@@ -35,16 +36,9 @@ const latencies = [];
 
 before(async () => {
   assert.ok(bin && existsSync(bin), 'build flourish first (cargo build --release)');
-  server = spawn(bin, ['serve', '--port', '0'], { stdio: ['ignore', 'pipe', 'inherit'] });
-  url = await new Promise((ok, fail) => {
-    let text = '';
-    server.stdout.on('data', (b) => {
-      text += b;
-      const m = /(http:\/\/\S+\/)/.exec(text);
-      if (m) ok(m[1]);
-    });
-    server.on('exit', (code) => fail(new Error(`flourish serve exited with ${code}`)));
-  });
+  const started = startServer(bin);
+  server = started.server;
+  url = await started.url;
   context = await chromium.launchPersistentContext(join(work, 'profile'), {
     executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
     headless: true,
