@@ -756,11 +756,17 @@ pub fn brush_sketch(style: &BrushStyle, sketch: &Sketch, opts: &Settings) -> Res
     let trace = TraceOptions::default();
     // The cost is stated before any synthesis: the canvases of all the
     // strokes together.
+    fn part(q: &QuerySpine) -> impl Fn(Error) -> Error + '_ {
+        move |e| e.in_part(format!("query {}", q.query_id))
+    }
+    let layouts = spines
+        .iter()
+        .map(|q| layout(style, q, opts).map_err(part(q)))
+        .collect::<Result<Vec<_>>>()?;
     let mut total = 0u64;
     let mut largest = (0u64, "");
-    for q in &spines {
-        let part = |e: Error| e.in_part(format!("query {}", q.query_id));
-        let px = layout(style, q, opts).map_err(part)?.pixels();
+    for (q, l) in spines.iter().zip(&layouts) {
+        let px = l.pixels();
         total = total.saturating_add(px);
         if px > largest.0 {
             largest = (px, &q.query_id);
@@ -778,17 +784,16 @@ pub fn brush_sketch(style: &BrushStyle, sketch: &Sketch, opts: &Settings) -> Res
     let tally = crate::io::Tally::new("brush: strokes synthesized", spines.len());
     let done: Vec<Vec<(QueryResult, Group)>> = spines
         .par_iter()
-        .map(|q| {
+        .zip(&layouts)
+        .map(|(q, l)| {
             let mut out = Vec::new();
-            let mut finish = |r: QueryResult| -> Result<()> {
-                out.push(finish_query(style, r, refine, opts, &trace));
-                Ok(())
-            };
-            let part = |e: Error| e.in_part(format!("query {}", q.query_id));
-            if let Layout::Whole(_) = layout(style, q, opts).map_err(part)? {
-                finish(brush_query(style, q, opts).map_err(part)?)?;
-            } else {
-                in_pieces(style, q, opts, &mut finish).map_err(part)?;
+            let mut finish =
+                |r: QueryResult| out.push(finish_query(style, r, refine, opts, &trace));
+            match l {
+                Layout::Whole(_) => finish(brush_query(style, q, opts).map_err(part(q))?),
+                Layout::Pieces(pieces) => {
+                    in_pieces(style, q, opts, pieces, &mut finish).map_err(part(q))?
+                }
             }
             tally.tick();
             Ok(out)

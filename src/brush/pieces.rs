@@ -19,8 +19,8 @@
 
 use super::analysis::BrushStyle;
 use super::pipeline::{
-    init_field, matched, query_share, Canvas, Plan, QueryResult, Settings, BYTES_PER_CANVAS_PX,
-    SEAM_MARGIN,
+    init_field, matched, query_share, samples_box, Canvas, Plan, QueryResult, Settings,
+    BYTES_PER_CANVAS_PX, SEAM_MARGIN,
 };
 use super::query::QuerySpine;
 use super::synth::{self, Field, SynthOptions};
@@ -57,8 +57,8 @@ const NO_SAMPLE: u32 = u32::MAX;
 /// One piece of a long stroke: its canvas, and the samples its canvas
 /// covers (`lo..=hi`) and keeps in its output (`keep`: from its first
 /// own sample to half the overlap into the next piece).
-#[derive(Clone, Debug)]
-struct Piece {
+#[derive(Clone, Debug, PartialEq)]
+pub struct Piece {
     canvas: Canvas,
     lo: usize,
     hi: usize,
@@ -74,22 +74,25 @@ struct Done {
     levels: Vec<Field>,
 }
 
-/// How a query is synthesized: on one canvas, or in pieces; with the
-/// top-level canvas pixels it takes in all (the cost the sketch's budget
-/// counts).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// How a query is synthesized: on one canvas, or in pieces.
+#[derive(Clone, Debug, PartialEq)]
 pub enum Layout {
     /// One canvas ([`super::pipeline::brush_query`]) of this many pixels.
     Whole(u64),
-    /// Pieces ([`in_pieces`]) of this many pixels together.
-    Pieces(u64),
+    /// These pieces ([`in_pieces`]).
+    Pieces(Vec<Piece>),
 }
 
 impl Layout {
-    /// Top-level canvas pixels in all.
-    pub fn pixels(self) -> u64 {
+    /// Top-level canvas pixels in all (the cost the sketch's budget
+    /// counts).
+    pub fn pixels(&self) -> u64 {
         match self {
-            Layout::Whole(n) | Layout::Pieces(n) => n,
+            Layout::Whole(n) => *n,
+            Layout::Pieces(pieces) => pieces
+                .iter()
+                .map(|p| p.canvas.width as u64 * p.canvas.height as u64)
+                .sum(),
         }
     }
 }
@@ -107,13 +110,7 @@ pub fn layout(style: &BrushStyle, q: &QuerySpine, opts: &Settings) -> Result<Lay
         }
     }
     let (ppu, factor) = piece_scale(style, q, plan);
-    let pieces = cut(q, ppu, factor, piece_pixels(opts))?;
-    Ok(Layout::Pieces(
-        pieces
-            .iter()
-            .map(|p| p.canvas.width as u64 * p.canvas.height as u64)
-            .sum(),
-    ))
+    Ok(Layout::Pieces(cut(q, ppu, factor, piece_pixels(opts))?))
 }
 
 /// Top-level px per sketch unit and top over start pixel size of `q`'s
@@ -131,26 +128,26 @@ fn piece_pixels(opts: &Settings) -> u64 {
     opts.pieces.unwrap_or(PIECE_PIXELS).min(share).max(1)
 }
 
-/// Synthesizes `q` piece by piece (see the module docs), handing each
-/// piece's result to `emit` as soon as it is done, so only two pieces'
-/// fields are held at a time.
+/// Synthesizes `q` piece by piece on `pieces` (its [`layout`]; see the
+/// module docs), handing each piece's result to `emit` as soon as it is
+/// done, so only two pieces' fields are held at a time.
 pub fn in_pieces(
     style: &BrushStyle,
     q: &QuerySpine,
     opts: &Settings,
-    emit: &mut dyn FnMut(QueryResult) -> Result<()>,
+    pieces: &[Piece],
+    emit: &mut dyn FnMut(QueryResult),
 ) -> Result<()> {
     let plan = Plan::of(style, q, opts)?;
     let (start, top) = (plan.start, plan.top);
-    let (ppu, factor) = piece_scale(style, q, plan);
-    let pieces = cut(q, ppu, factor, piece_pixels(opts))?;
+    let factor = 1usize << (top - start);
     let (ribs, m) = matched(style, q, opts, plan.ew)?;
     let sopts = SynthOptions {
         seed: opts.seed,
         ..opts.synth.clone()
     };
     let mut prev: Option<Done> = None;
-    for p in &pieces {
+    for p in pieces {
         let c = p.canvas;
         let what = format!(
             "the {}×{} px canvas of a piece of query {}",
@@ -193,7 +190,7 @@ pub fn in_pieces(
                 Vec::new()
             },
         };
-        emit(result)?;
+        emit(result);
         prev = Some(Done { canvas: c, levels });
     }
     Ok(())
@@ -272,12 +269,7 @@ fn lattice_canvas(
     factor: usize,
     anchor: Point,
 ) -> Option<Canvas> {
-    let samples = q.samples.get(lo..=hi)?;
-    let (mut x0, mut y0, mut x1, mut y1) = (f64::MAX, f64::MAX, f64::MIN, f64::MIN);
-    for s in samples {
-        (x0, y0) = (x0.min(s.pos.x), y0.min(s.pos.y));
-        (x1, y1) = (x1.max(s.pos.x), y1.max(s.pos.y));
-    }
+    let [x0, y0, x1, y1] = samples_box(q.samples.get(lo..=hi)?);
     let m = 1.5 * q.width;
     let step = factor.max(1) as f64 / ppu;
     let ox = anchor.x + ((x0 - m - anchor.x) / step).floor() * step;

@@ -31,7 +31,7 @@ use super::arap::{rasterize_coords, Arap, RibMesh};
 use super::baseline::art_brush_coords;
 use super::graphcut::{seam, Cover, Label, SeamParams};
 use super::matching::{match_query, MatchOptions, MatchedSegment, Matching, SpineFeatures};
-use super::query::{QueryOptions, QuerySpine};
+use super::query::{QueryOptions, QuerySample, QuerySpine};
 pub use super::ribs::exemplar_width;
 use super::ribs::{exemplar_features, resample_ribs, Resampled};
 use super::synth::{self, Coord, Field, SynthOptions};
@@ -263,11 +263,7 @@ pub const MAX_OUT_PIXELS: u64 = 32 << 20;
 /// allocated.
 pub fn canvas_for(q: &QuerySpine, ew: f64, factor: usize) -> Result<Canvas> {
     let ppu = ew / q.width;
-    let (mut x0, mut y0, mut x1, mut y1) = (f64::MAX, f64::MAX, f64::MIN, f64::MIN);
-    for s in &q.samples {
-        (x0, y0) = (x0.min(s.pos.x), y0.min(s.pos.y));
-        (x1, y1) = (x1.max(s.pos.x), y1.max(s.pos.y));
-    }
+    let [x0, y0, x1, y1] = samples_box(&q.samples);
     let m = 1.5 * q.width;
     let f = factor.max(1) as f64;
     let cw = ((x1 - x0 + 2.0 * m) * ppu / f).ceil();
@@ -297,6 +293,17 @@ pub fn canvas_for(q: &QuerySpine, ew: f64, factor: usize) -> Result<Canvas> {
         height: ch as usize * factor,
         factor,
     })
+}
+
+/// The box `[x0, y0, x1, y1]` of the samples' positions, sketch units
+/// (inverted, min above max, when there are none).
+pub(crate) fn samples_box(samples: &[QuerySample]) -> [f64; 4] {
+    let (mut x0, mut y0, mut x1, mut y1) = (f64::MAX, f64::MAX, f64::MIN, f64::MIN);
+    for s in samples {
+        (x0, y0) = (x0.min(s.pos.x), y0.min(s.pos.y));
+        (x1, y1) = (x1.max(s.pos.x), y1.max(s.pos.y));
+    }
+    [x0, y0, x1, y1]
 }
 
 /// The query orientation ω^q of a coordinate field from one warped
