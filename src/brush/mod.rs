@@ -38,6 +38,7 @@ pub mod pieces;
 pub mod pipeline;
 pub mod query;
 pub mod ribs;
+pub mod swell;
 pub mod synth;
 
 use crate::error::{Error, Result};

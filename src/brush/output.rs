@@ -608,6 +608,7 @@ fn trace_field(
             });
         }
     }
+    super::swell::apply(&r.spine, &mut shapes);
     Group { id, shapes }
 }
 
@@ -786,6 +787,18 @@ pub fn brush_sketch(style: &BrushStyle, sketch: &Sketch, opts: &Settings) -> Res
         .par_iter()
         .zip(&layouts)
         .map(|(q, l)| {
+            // A shape's own `data-seed` stands in for the run's.
+            let own;
+            let opts = match q.seed {
+                Some(seed) if seed != opts.seed => {
+                    own = Settings {
+                        seed,
+                        ..opts.clone()
+                    };
+                    &own
+                }
+                _ => opts,
+            };
             let mut out = Vec::new();
             let mut finish =
                 |r: QueryResult| out.push(finish_query(style, r, refine, opts, &trace));

@@ -435,6 +435,7 @@ fn sub_spine(q: &QuerySpine, keep: &std::ops::Range<usize>) -> QuerySpine {
         query_id: q.query_id.clone(),
         subpath: q.subpath,
         style: q.style.clone(),
+        seed: q.seed,
         width: q.width,
         spacing: q.spacing,
         length: q.spacing * samples.len().saturating_sub(1) as f64,

@@ -495,7 +495,8 @@ pub fn fill_sketch<'s>(
             region.height(),
             region.area
         ));
-        let seed = crate::rng::hash(&[opts.seed, qi as u64]);
+        // A shape's own `data-seed` stands in for the run's.
+        let seed = crate::rng::hash(&[q.seed.unwrap_or(opts.seed), qi as u64]);
         let syn = prepared.synthesize(&region.direction, Some(&region.mask), seed);
         let mut layers = syn.layers;
         // Occlusion order: each layer extends under the layers above it.
