@@ -391,6 +391,15 @@ function drawingKey() {
 /** Forgets the settled drawing (something changed) and shows the strokes. */
 function unsettle() {
   clearTimeout(settleTimer);
+  if (state.settling) {
+    // The drawing changed under its synthesis: the server ends it.
+    state.settling = 0;
+    fetch('/api/cancel', {
+      method: 'POST',
+      headers: { 'Content-Type': 'application/json' },
+      body: JSON.stringify({ lane: 'drawing', generation: ++state.generation }),
+    }).catch(() => {});
+  }
   state.settled = null;
   $('settled').replaceChildren();
   $('results').removeAttribute('display');
@@ -409,7 +418,9 @@ async function settle() {
   const generation = ++state.generation;
   state.settling = generation;
   const { status: code, reply } = await synthesize(request(state.strokes, 'drawing', generation));
-  if (state.settling !== generation || code !== 200 || drawingKey() !== key) return;
+  const stale = state.settling !== generation;
+  if (!stale) state.settling = 0;
+  if (stale || code !== 200 || drawingKey() !== key) return;
   state.settled = { key, svg: reply.svg };
   const doc = new DOMParser().parseFromString(reply.svg, 'image/svg+xml');
   const node = document.importNode(doc.documentElement, true);

@@ -799,11 +799,16 @@ pub fn brush_sketch(style: &BrushStyle, sketch: &Sketch, opts: &Settings) -> Res
                 }
                 _ => opts,
             };
+            crate::io::check(&opts.cancel)?;
             let mut out = Vec::new();
             let mut finish =
                 |r: QueryResult| out.push(finish_query(style, r, refine, opts, &trace));
             match l {
-                Layout::Whole(_) => finish(brush_query(style, q, opts).map_err(part(q))?),
+                Layout::Whole(_) => {
+                    let r = brush_query(style, q, opts).map_err(part(q))?;
+                    crate::io::check(&opts.cancel)?;
+                    finish(r)
+                }
                 Layout::Pieces(pieces) => {
                     in_pieces(style, q, opts, pieces, &mut finish).map_err(part(q))?
                 }

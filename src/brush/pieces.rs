@@ -148,6 +148,7 @@ pub fn in_pieces(
     };
     let mut prev: Option<Done> = None;
     for p in pieces {
+        crate::io::check(&opts.cancel)?;
         let c = p.canvas;
         let what = format!(
             "the {}×{} px canvas of a piece of query {}",
