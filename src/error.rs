@@ -72,6 +72,10 @@ pub enum Error {
         /// What is wrong with it.
         reason: String,
     },
+    /// The run was cancelled through its options' [`crate::Cancel`]
+    /// handle before it finished.
+    #[error("cancelled")]
+    Cancelled,
     /// An option has a value the library cannot use.
     #[error("invalid option {name}: {reason}")]
     Option {

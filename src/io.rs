@@ -12,6 +12,50 @@ use std::sync::Mutex;
 /// takes it first ([`exit_between_writes`]).
 static WRITES: Mutex<()> = Mutex::new(());
 
+/// A handle that cancels a run from another thread (a newer request
+/// superseding it): clones share one flag; a mode checks it between its
+/// stages and queries and then ends with [`Error::Cancelled`]. Two
+/// handles are equal when they share the flag.
+#[derive(Clone, Debug, Default)]
+pub struct Cancel(std::sync::Arc<std::sync::atomic::AtomicBool>);
+
+impl Cancel {
+    /// A handle not cancelled yet.
+    pub fn new() -> Cancel {
+        Cancel::default()
+    }
+
+    /// Cancels every run holding this handle or a clone of it.
+    pub fn cancel(&self) {
+        self.0.store(true, std::sync::atomic::Ordering::Relaxed);
+    }
+
+    /// Whether [`Self::cancel`] was called.
+    pub fn is_cancelled(&self) -> bool {
+        self.0.load(std::sync::atomic::Ordering::Relaxed)
+    }
+
+    /// `Err(Error::Cancelled)` once cancelled, for `?` between stages.
+    pub fn check(&self) -> Result<()> {
+        if self.is_cancelled() {
+            Err(Error::Cancelled)
+        } else {
+            Ok(())
+        }
+    }
+}
+
+impl PartialEq for Cancel {
+    fn eq(&self, other: &Cancel) -> bool {
+        std::sync::Arc::ptr_eq(&self.0, &other.0)
+    }
+}
+
+/// Checks an optional [`Cancel`] handle (none: never cancelled).
+pub(crate) fn check(cancel: &Option<Cancel>) -> Result<()> {
+    cancel.as_ref().map_or(Ok(()), Cancel::check)
+}
+
 /// What the run is doing now, for a progress line ([`stage`]).
 static STAGE: Mutex<String> = Mutex::new(String::new());
 

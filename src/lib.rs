@@ -61,6 +61,7 @@ pub use brush::{BrushOptions, Refinement, MAX_ITERATIONS};
 pub use diff::DiffReport;
 pub use error::{Error, Result};
 pub use fill::FillOptions;
+pub use io::Cancel;
 pub use library::{Library, Style, StyleEntry, StyleOptions, Styles, STYLES_ENV};
 pub use pattern::PatternOptions;
 pub use read::sketch::{Query, QueryKind, Sketch};

@@ -708,6 +708,7 @@ fn run_brush(args: BrushArgs, quiet: bool, verbose: bool) -> Result<(), Failure>
             refine: refine.clone(),
             // Only --verbose prints each query's energy.
             measure: verbose,
+            cancel: None,
         };
         let job = |sketch: &Path| -> Result<String, Error> {
             let sk = load_drawn(sketch, args.width, quiet, verbose)?;

@@ -1,6 +1,7 @@
 //! `flourish brush` on the command line: variations written side by side,
 //! a sketch with nothing to brush refused in one line with no output, and
-//! exemplars with no clear main branch warned about and still used.
+//! exemplars with no clear main branch warned about and still used; a
+//! stroke's width along it (`data-widths`) and its own seed (`data-seed`).
 
 use std::path::PathBuf;
 
@@ -121,4 +122,163 @@ fn exemplars_without_a_main_branch_warn_and_fall_back() {
         svg.contains("<g id=\"s-curve\"") && svg.contains("<path"),
         "{svg}"
     );
+}
+
+/// The shipped vine, its analysis cached beside the other brush tests'.
+fn vine() -> flourish::Style {
+    let opts = flourish::StyleOptions {
+        cache_dir: Some(std::env::temp_dir().join("flourish-test-cache")),
+        ..Default::default()
+    };
+    flourish::Library::shipped()
+        .load("vine", &opts)
+        .expect("vine loads")
+}
+
+/// Brushes `body` (shapes on a 600 × 200 page) with the vine, seed 0.
+fn brush_svg(style: &flourish::Style, body: &str) -> flourish::Result<flourish::Output> {
+    let svg = format!(
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="600" height="200" viewBox="0 0 600 200">{body}</svg>"#
+    );
+    let sketch = flourish::Sketch::from_svg(svg.as_bytes())?;
+    flourish::brush(&sketch, style, &flourish::BrushOptions::default())
+}
+
+/// The farthest any point of the ink's outlines (control points
+/// included) lies from the line y = 100 with x in `xs`.
+fn extent(out: &flourish::Output, xs: std::ops::Range<f64>) -> f64 {
+    let mut far = 0.0f64;
+    for g in &out.document.groups {
+        for s in &g.shapes {
+            for el in s.path.elements() {
+                for p in el_points(el) {
+                    if xs.contains(&p.x) {
+                        far = far.max((p.y - 100.0).abs());
+                    }
+                }
+            }
+        }
+    }
+    far
+}
+
+fn el_points(el: &kurbo::PathEl) -> Vec<kurbo::Point> {
+    use kurbo::PathEl::*;
+    match *el {
+        MoveTo(a) | LineTo(a) => vec![a],
+        QuadTo(a, b) => vec![a, b],
+        CurveTo(a, b, c) => vec![a, b, c],
+        ClosePath => vec![],
+    }
+}
+
+/// A stroke whose width grows from 10 to 30 (`data-widths`) is the same
+/// ornament as at its mean width, 20, with every offset across the stroke
+/// scaled by the width there: near its start the ink reaches about half
+/// as far as at 20, near its end about 1.4 times as far, so the end is
+/// 2–3.5 times as wide as the start; constant widths are no widths at
+/// all, byte for byte.
+#[test]
+fn data_widths_swell_and_thin_the_ornament() {
+    let style = vine();
+    let path = |extra: &str| {
+        format!(
+            r#"<path id="s" d="M40 100 L560 100" fill="none" stroke="black" stroke-width="20" {extra}/>"#
+        )
+    };
+    let plain = brush_svg(&style, &path("")).unwrap();
+    let grown = brush_svg(&style, &path(r#"data-widths="10 30""#)).unwrap();
+    let constant = brush_svg(&style, &path(r#"data-widths="20, 20 20""#)).unwrap();
+    assert_eq!(plain.to_svg(), constant.to_svg());
+    // The width at x: 10 + 20 (x − 40) / 520.
+    let width = |x: f64| 10.0 + 20.0 * (x - 40.0) / 520.0;
+    let (head, tail) = (80.0..140.0, 460.0..520.0);
+    let (p0, p1) = (extent(&plain, head.clone()), extent(&plain, tail.clone()));
+    let (g0, g1) = (extent(&grown, head), extent(&grown, tail));
+    assert!(p0 > 5.0 && p1 > 5.0, "the vine reaches out: {p0} {p1}");
+    // The farthest point of a window sits somewhere in it: the scale is
+    // the width between its ends' widths, over 20.
+    let within = |got: f64, at: f64, lo: f64, hi: f64| {
+        let k = got / at;
+        assert!(
+            k >= width(lo) / 20.0 - 0.03 && k <= width(hi) / 20.0 + 0.03,
+            "{got} over {at}: {k} not in {}..{}",
+            width(lo) / 20.0,
+            width(hi) / 20.0
+        );
+    };
+    within(g0, p0, 80.0, 140.0);
+    within(g1, p1, 460.0, 520.0);
+    let ratio = (g1 / p1) / (g0 / p0);
+    assert!((2.0..=3.5).contains(&ratio), "end over start {ratio}");
+}
+
+/// Bad `data-widths` (a count of none, NaN, a negative or zero width, a
+/// word) and a bad `data-seed` are refused in one line naming the shape.
+#[test]
+fn bad_data_widths_and_seeds_name_the_shape() {
+    let style = vine();
+    for attr in [
+        r#"data-widths="""#,
+        r#"data-widths="10 NaN 12""#,
+        r#"data-widths="10 -2""#,
+        r#"data-widths="0""#,
+        r#"data-widths="10 wide""#,
+        r#"data-seed="-1""#,
+        r#"data-seed="1.5""#,
+    ] {
+        let body = format!(
+            r#"<path id="pen-7" d="M40 100 L560 100" fill="none" stroke="black" stroke-width="20" {attr}/>"#
+        );
+        let e = match brush_svg(&style, &body) {
+            Ok(_) => panic!("{attr} is refused"),
+            Err(e) => e.to_string(),
+        };
+        assert!(
+            e.contains("shape pen-7") && !e.contains('\n'),
+            "{attr}: {e}"
+        );
+        let name = if attr.contains("seed") {
+            "data-seed"
+        } else {
+            "data-widths"
+        };
+        assert!(e.contains(name), "{attr}: {e}");
+    }
+}
+
+/// A shape's `data-seed` stands in for the run's seed for that shape
+/// alone: its ornament is the one the run's seed would give if it were
+/// that seed, and the other strokes keep theirs.
+#[test]
+fn data_seed_reseeds_one_stroke() {
+    let style = vine();
+    let strokes = |seed_attr: &str| {
+        format!(
+            r#"<path id="a" d="M40 50 L560 50" fill="none" stroke="black" stroke-width="20"/><path id="b" d="M40 150 L560 150" fill="none" stroke="black" stroke-width="20" {seed_attr}/>"#
+        )
+    };
+    let group = |out: &flourish::Output, id: &str| {
+        let g = out.document.groups.iter().find(|g| g.id == id).expect(id);
+        g.shapes.clone()
+    };
+    let run = |body: &str, seed: u64| {
+        let svg = format!(
+            r#"<svg xmlns="http://www.w3.org/2000/svg" width="600" height="200" viewBox="0 0 600 200">{body}</svg>"#
+        );
+        let sketch = flourish::Sketch::from_svg(svg.as_bytes()).unwrap();
+        let opts = flourish::BrushOptions {
+            seed,
+            ..Default::default()
+        };
+        flourish::brush(&sketch, &style, &opts).unwrap()
+    };
+    let zero = run(&strokes(""), 0);
+    let five = run(&strokes(""), 5);
+    let mixed = run(&strokes(r#"data-seed="5""#), 0);
+    assert_ne!(group(&zero, "b"), group(&five, "b"), "seeds differ");
+    assert_eq!(group(&mixed, "a"), group(&zero, "a"));
+    assert_eq!(group(&mixed, "b"), group(&five, "b"));
+    // The run's own seed written on the shape changes nothing.
+    assert_eq!(run(&strokes(r#"data-seed="0""#), 0).to_svg(), zero.to_svg());
 }

@@ -454,3 +454,129 @@ fn a_made_style_downloads_as_a_zip_of_its_folder() {
         .expect("style.toml");
     assert!(a < b);
 }
+
+/// A cancel handle set before the run ends it at its first check with
+/// the typed error, for brush and fill alike; a fresh handle changes
+/// nothing.
+#[test]
+fn a_cancelled_run_ends_with_the_cancelled_error() {
+    let vine = Library::shipped()
+        .load("vine", &StyleOptions::default())
+        .expect("vine");
+    let knot = Library::shipped()
+        .load("knot", &StyleOptions::default())
+        .expect("knot");
+    let cancel = flourish::Cancel::new();
+    cancel.cancel();
+    let strokes = Sketch::from_svg(STROKES.as_bytes()).expect("sketch");
+    let shape = Sketch::from_svg(SHAPE.as_bytes()).expect("sketch");
+    let brushed = flourish::brush(
+        &strokes,
+        &vine,
+        &BrushOptions {
+            cancel: Some(cancel.clone()),
+            ..BrushOptions::default()
+        },
+    );
+    assert!(
+        matches!(
+            brushed.as_ref().map_err(|e| e.cause()),
+            Err(flourish::Error::Cancelled)
+        ),
+        "{:?}",
+        brushed.err()
+    );
+    let filled = flourish::fill(
+        &shape,
+        &knot,
+        &FillOptions {
+            cancel: Some(cancel),
+            ..FillOptions::default()
+        },
+    );
+    assert!(
+        matches!(
+            filled.as_ref().map_err(|e| e.cause()),
+            Err(flourish::Error::Cancelled)
+        ),
+        "{:?}",
+        filled.err()
+    );
+    let fresh = BrushOptions {
+        cancel: Some(flourish::Cancel::new()),
+        ..BrushOptions::default()
+    };
+    assert_eq!(
+        flourish::brush(&strokes, &vine, &fresh)
+            .expect("brushes")
+            .to_svg(),
+        flourish::brush(&strokes, &vine, &BrushOptions::default())
+            .expect("brushes")
+            .to_svg()
+    );
+}
+
+/// A synthesis of many strokes superseded through `POST /api/cancel`
+/// while it runs gets 409 well before it would have finished, and the
+/// next request is served.
+#[test]
+fn a_running_synthesis_is_cancelled_by_a_newer_generation() {
+    let server = start();
+    let addr = server.addr;
+    let mut body = String::from(
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="800" height="1600" viewBox="0 0 800 1600">"#,
+    );
+    for i in 0..24 {
+        let y = 40 + 64 * i;
+        body.push_str(&format!(
+            r#"<path d="M40 {y} C 240 {a}, 520 {b}, 760 {y}" fill="none" stroke="black" stroke-width="20"/>"#,
+            a = y - 30,
+            b = y + 30
+        ));
+    }
+    body.push_str("</svg>");
+    let req = serde_json::json!({"sketch": body, "mode": "brush", "style": "vine", "lane": "drawing", "generation": 1});
+    let started = std::time::Instant::now();
+    let big = std::thread::spawn(move || {
+        let body = req.to_string();
+        let head = format!(
+            "POST /api/synthesize HTTP/1.1\r\nHost: {addr}\r\nContent-Length: {}\r\nConnection: close\r\n\r\n",
+            body.len()
+        );
+        let (status, reply) = exchange(addr, &head, body.as_bytes());
+        (status, reply, started.elapsed())
+    });
+    std::thread::sleep(Duration::from_millis(300));
+    let cancelled_at = started.elapsed();
+    let cancel = serde_json::json!({"lane": "drawing", "generation": 2});
+    assert_eq!(
+        post(&server, "/api/cancel", cancel.to_string().as_bytes()).0,
+        200
+    );
+    let (status, reply, ended) = big.join().expect("the big request");
+    assert_eq!(status, 409, "{}", String::from_utf8_lossy(&reply));
+    println!(
+        "cancelled at {} ms, the reply came {} ms later",
+        cancelled_at.as_millis(),
+        (ended - cancelled_at).as_millis()
+    );
+    // The whole drawing, uncancelled, for comparison.
+    let t = std::time::Instant::now();
+    let whole = serde_json::json!({"sketch": body, "mode": "brush", "style": "vine"});
+    assert_eq!(
+        post(&server, "/api/synthesize", whole.to_string().as_bytes()).0,
+        200
+    );
+    println!(
+        "the same drawing uncancelled: {} ms",
+        t.elapsed().as_millis()
+    );
+    for (want, bad) in [(400, "{\"lane\": 3}"), (400, "not json"), (405, "")] {
+        let (status, _) = if want == 405 {
+            get(&server, "/api/cancel")
+        } else {
+            post(&server, "/api/cancel", bad.as_bytes())
+        };
+        assert_eq!(status, want, "{bad}");
+    }
+}

@@ -13,9 +13,14 @@ const state = {
   W: 800, // document width, px
   H: 560, // document height, px
   styles: [], // [{name, kind, exemplars}]
-  strokes: [], // [{id, mode, style, points: [[x, y, w]], closed, gen, svg, status}]
+  // [{id, mode, style, points: [[x, y, w]], widths, seed, closed, gen, svg, status}]:
+  // `widths` the pressure widths at evenly spaced positions along the
+  // stroke (its data-widths; null when constant), `seed` its own seed
+  // (data-seed; undefined: the drawing's).
+  strokes: [],
   refine: [], // refinement strokes over brush results: [{points: [[x, y, w]], add}]
-  history: [], // undo entries: {type: 'add'|'erase'|'seed', ...}
+  history: [], // undo entries: {type: 'add'|'erase'|'seed'|'stroke-seed'|'refine', ...}
+  current: null, // the stroke "another one" draws again: the last drawn
   seed: 0,
   nextId: 1,
   generation: 0,
@@ -137,14 +142,67 @@ function meanWidth(stroke) {
   return Math.round((p.reduce((a, q) => a + q[2], 0) / p.length) * 100) / 100;
 }
 
+/** The arc length from a polyline's start to each of its points. */
+function arcLengths(points) {
+  const at = [0];
+  for (let i = 1; i < points.length; i++) {
+    at.push(at[i - 1] + Math.hypot(points[i][0] - points[i - 1][0], points[i][1] - points[i - 1][1]));
+  }
+  return at;
+}
+
+/** Most values of a stroke's `data-widths`. */
+const MAX_WIDTHS = 32;
+
+/** The stroke's pressure widths as `data-widths` has them: at `n` evenly
+ * spaced positions along its length, first at the start and last at the
+ * end (rounded to 0.01 px); null when they are all the same. */
+function widthProfile(points) {
+  const at = arcLengths(points);
+  const total = at[at.length - 1];
+  const n = Math.max(2, Math.min(MAX_WIDTHS, points.length));
+  const out = [];
+  let j = 0;
+  for (let i = 0; i < n; i++) {
+    const s = (total * i) / (n - 1);
+    while (j < at.length - 2 && at[j + 1] < s) j++;
+    const span = at[j + 1] - at[j];
+    const f = span > 0 ? Math.min(1, Math.max(0, (s - at[j]) / span)) : 0;
+    const w = points[j][2] * (1 - f) + points[Math.min(j + 1, points.length - 1)][2] * f;
+    out.push(Math.max(0.01, Math.round(w * 100) / 100));
+  }
+  return out.every((w) => w === out[0]) ? null : out;
+}
+
+/** The value of evenly spaced `widths` at `share` (0..1) of the length. */
+function profileAt(widths, share) {
+  if (widths.length === 1) return widths[0];
+  const x = Math.min(1, Math.max(0, share)) * (widths.length - 1);
+  const i = Math.min(widths.length - 2, Math.floor(x));
+  return widths[i] * (1 - (x - i)) + widths[i + 1] * (x - i);
+}
+
+/** The stroke width written for an open stroke: the mean of its
+ * `data-widths` over the length (the command line reads it so), else its
+ * points' mean. */
+function strokeWidth(stroke) {
+  const w = stroke.widths;
+  if (!w) return meanWidth(stroke);
+  let sum = 0.5 * (w[0] + w[w.length - 1]);
+  for (let i = 1; i < w.length - 1; i++) sum += w[i];
+  return Math.round((sum / (w.length - 1)) * 100) / 100;
+}
+
 function shapeElement(stroke) {
-  const attrs = [`id="${stroke.id}"`, `data-style="${stroke.style}"`, `d="${pathData(stroke)}"`];
+  const attrs = [`id="${stroke.id}"`, `data-style="${stroke.style}"`];
+  if (stroke.seed !== undefined) attrs.push(`data-seed="${stroke.seed}"`);
+  attrs.push(`d="${pathData(stroke)}"`);
   if (stroke.closed) {
     attrs.push('fill="black"');
   } else {
-    attrs.push('fill="none" stroke="black"', `stroke-width="${fmt(meanWidth(stroke))}"`,
-      'stroke-linecap="round" stroke-linejoin="round"',
-      `data-widths="${stroke.points.map((q) => fmt(q[2])).join(' ')}"`);
+    attrs.push('fill="none" stroke="black"', `stroke-width="${fmt(strokeWidth(stroke))}"`,
+      'stroke-linecap="round" stroke-linejoin="round"');
+    if (stroke.widths) attrs.push(`data-widths="${stroke.widths.map(fmt).join(' ')}"`);
   }
   return `<path ${attrs.join(' ')}/>`;
 }
@@ -333,6 +391,15 @@ function drawingKey() {
 /** Forgets the settled drawing (something changed) and shows the strokes. */
 function unsettle() {
   clearTimeout(settleTimer);
+  if (state.settling) {
+    // The drawing changed under its synthesis: the server ends it.
+    state.settling = 0;
+    fetch('/api/cancel', {
+      method: 'POST',
+      headers: { 'Content-Type': 'application/json' },
+      body: JSON.stringify({ lane: 'drawing', generation: ++state.generation }),
+    }).catch(() => {});
+  }
   state.settled = null;
   $('settled').replaceChildren();
   $('results').removeAttribute('display');
@@ -351,7 +418,9 @@ async function settle() {
   const generation = ++state.generation;
   state.settling = generation;
   const { status: code, reply } = await synthesize(request(state.strokes, 'drawing', generation));
-  if (state.settling !== generation || code !== 200 || drawingKey() !== key) return;
+  const stale = state.settling !== generation;
+  if (!stale) state.settling = 0;
+  if (stale || code !== 200 || drawingKey() !== key) return;
   state.settled = { key, svg: reply.svg };
   const doc = new DOMParser().parseFromString(reply.svg, 'image/svg+xml');
   const node = document.importNode(doc.documentElement, true);
@@ -394,10 +463,12 @@ function onDown(e) {
     return;
   }
   if (e.button !== 0) return;
-  if (tool() === 'erase') {
+  if (tool() === 'erase' || tool() === 'another') {
     const id = e.target.closest('[data-stroke]')?.dataset.stroke || e.target.closest('#settled g[id]')?.id;
     const i = state.strokes.findIndex((s) => s.id === id);
-    if (i >= 0) {
+    if (i >= 0 && tool() === 'another') {
+      anotherOne(state.strokes[i]);
+    } else if (i >= 0) {
       const [stroke] = state.strokes.splice(i, 1);
       state.history.push({ type: 'erase', stroke, index: i });
       redraw();
@@ -466,8 +537,10 @@ function onUp(e) {
     rerunAll(started);
     return;
   }
+  if (!stroke.closed) stroke.widths = widthProfile(stroke.points);
   state.strokes.push(stroke);
   state.history.push({ type: 'add', stroke });
+  state.current = stroke;
   redraw();
   run(stroke, started);
 }
@@ -500,6 +573,11 @@ function undo() {
     setSeed(h.seed);
     redraw();
     rerunAll();
+    return;
+  } else if (h.type === 'stroke-seed') {
+    h.stroke.seed = h.seed;
+    if (state.strokes.includes(h.stroke)) run(h.stroke, performance.now());
+    status('undone');
     return;
   }
   redraw();
@@ -534,10 +612,29 @@ function drawRefine() {
   }));
 }
 
-function another() {
+/** Another one of the whole drawing: the next seed for every stroke
+ * without a seed of its own. */
+function reseedAll() {
   state.history.push({ type: 'seed', seed: state.seed });
   setSeed(state.seed + 1);
   rerunAll();
+}
+
+/** Another one of `stroke` alone: its own next seed (`data-seed`), so the
+ * other strokes keep their ornament. */
+function anotherOne(stroke) {
+  state.history.push({ type: 'stroke-seed', stroke, seed: stroke.seed });
+  stroke.seed = (stroke.seed === undefined ? state.seed : stroke.seed) + 1;
+  state.current = stroke;
+  run(stroke, performance.now());
+  status(`${stroke.id}: seed ${stroke.seed}`);
+}
+
+/** The button: another one of the last stroke drawn (or picked). */
+function another() {
+  const s = state.current;
+  if (s && state.strokes.includes(s)) anotherOne(s);
+  else status('draw a stroke first, or pick one with the "another" tool');
 }
 
 // ---- zoom and pan -----------------------------------------------------
@@ -637,8 +734,11 @@ function importSketch(text) {
       const wanted = filled ? 'fill' : mode() === 'fill' ? 'brush' : mode();
       if (!style || !kindOf(style)) style = chosen[wanted] || state.styles.find((s) => s.kind === wanted)?.name;
       if (!style) continue;
-      const width = parseFloat(cs.strokeWidth) || 20;
-      const widths = (el.getAttribute('data-widths') || '').trim().split(/\s+/).map(Number);
+      let width = parseFloat(cs.strokeWidth) || 20;
+      const list = (el.getAttribute('data-widths') || '').trim().split(/[\s,]+/).filter((t) => t).map(Number);
+      const widths = !filled && list.length && list.every((w) => Number.isFinite(w) && w > 0) ? list : null;
+      const seedText = el.closest('[data-seed]')?.getAttribute('data-seed');
+      const seed = seedText && /^\d+$/.test(seedText.trim()) ? Number(seedText.trim()) : undefined;
       let pts;
       let closed = filled;
       const own = el.nodeName === 'path' && !el.getAttribute('transform') ? polylinePoints(el.getAttribute('d')) : null;
@@ -657,13 +757,18 @@ function importSketch(text) {
           pts.push([p.x, p.y]);
         }
       }
-      strokes.push({
+      const at = arcLengths(pts);
+      const total = at[at.length - 1] || 1;
+      const stroke = {
         id: `s-${state.nextId++}`,
         mode: kindOf(style),
         style,
-        points: pts.map(([x, y], i) => [x - ox, y - oy, widths.length === pts.length && widths[i] > 0 ? widths[i] : width]),
+        points: pts.map(([x, y], i) => [x - ox, y - oy, widths ? profileAt(widths, at[i] / total) : width]),
+        widths: widths && widths.length > 1 && !widths.every((w) => w === widths[0]) ? widths : null,
         closed,
-      });
+      };
+      if (seed !== undefined && Number.isSafeInteger(seed)) stroke.seed = seed;
+      strokes.push(stroke);
     }
   } finally {
     host.remove();
@@ -676,6 +781,7 @@ function importSketch(text) {
   state.refine = [];
   drawRefine();
   state.history = strokes.map((stroke) => ({ type: 'add', stroke }));
+  state.current = strokes[strokes.length - 1] || null;
   redraw();
   rerunAll();
   status(`imported ${strokes.length} shapes`);
@@ -708,6 +814,7 @@ function wire() {
   $('width').addEventListener('input', () => { $('width-value').textContent = $('width').value; });
   $('undo').addEventListener('click', undo);
   $('another').addEventListener('click', another);
+  $('reseed').addEventListener('click', reseedAll);
   $('zoom-in').addEventListener('click', () => zoom(1 / 1.25));
   $('zoom-out').addEventListener('click', () => zoom(1.25));
   $('zoom-reset').addEventListener('click', fit);

@@ -38,6 +38,7 @@ pub mod pieces;
 pub mod pipeline;
 pub mod query;
 pub mod ribs;
+pub mod swell;
 pub mod synth;
 
 use crate::error::{Error, Result};
@@ -70,6 +71,10 @@ pub struct BrushOptions {
     /// synthesis energy; the energy costs about one correction pass per
     /// query (default `false`).
     pub measure: bool,
+    /// Cancels the run from another thread: checked before each query,
+    /// each piece of a long one, its synthesis and its tracing; the run
+    /// then ends with [`Error::Cancelled`] (default `None`).
+    pub cancel: Option<crate::Cancel>,
 }
 
 impl Default for BrushOptions {
@@ -80,6 +85,7 @@ impl Default for BrushOptions {
             iterations: 1,
             refine: None,
             measure: false,
+            cancel: None,
         }
     }
 }
@@ -102,6 +108,7 @@ impl BrushOptions {
             seed: self.seed,
             art_brush: self.art_brush,
             refine: self.refine.clone(),
+            cancel: self.cancel.clone(),
             // Only a measuring run reads the fields after tracing.
             discard_fields: !self.measure,
             synth: synth::SynthOptions {

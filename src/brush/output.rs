@@ -608,6 +608,7 @@ fn trace_field(
             });
         }
     }
+    super::swell::apply(&r.spine, &mut shapes);
     Group { id, shapes }
 }
 
@@ -786,11 +787,28 @@ pub fn brush_sketch(style: &BrushStyle, sketch: &Sketch, opts: &Settings) -> Res
         .par_iter()
         .zip(&layouts)
         .map(|(q, l)| {
+            // A shape's own `data-seed` stands in for the run's.
+            let own;
+            let opts = match q.seed {
+                Some(seed) if seed != opts.seed => {
+                    own = Settings {
+                        seed,
+                        ..opts.clone()
+                    };
+                    &own
+                }
+                _ => opts,
+            };
+            crate::io::check(&opts.cancel)?;
             let mut out = Vec::new();
             let mut finish =
                 |r: QueryResult| out.push(finish_query(style, r, refine, opts, &trace));
             match l {
-                Layout::Whole(_) => finish(brush_query(style, q, opts).map_err(part(q))?),
+                Layout::Whole(_) => {
+                    let r = brush_query(style, q, opts).map_err(part(q))?;
+                    crate::io::check(&opts.cancel)?;
+                    finish(r)
+                }
                 Layout::Pieces(pieces) => {
                     in_pieces(style, q, opts, pieces, &mut finish).map_err(part(q))?
                 }

@@ -148,6 +148,7 @@ pub fn in_pieces(
     };
     let mut prev: Option<Done> = None;
     for p in pieces {
+        crate::io::check(&opts.cancel)?;
         let c = p.canvas;
         let what = format!(
             "the {}×{} px canvas of a piece of query {}",
@@ -435,6 +436,7 @@ fn sub_spine(q: &QuerySpine, keep: &std::ops::Range<usize>) -> QuerySpine {
         query_id: q.query_id.clone(),
         subpath: q.subpath,
         style: q.style.clone(),
+        seed: q.seed,
         width: q.width,
         spacing: q.spacing,
         length: q.spacing * samples.len().saturating_sub(1) as f64,

@@ -79,6 +79,8 @@ pub struct Settings {
     /// whole canvas does not fit, in pieces of
     /// [`super::pieces::PIECE_PIXELS`].
     pub pieces: Option<u64>,
+    /// Cancels the run between stages ([`crate::BrushOptions::cancel`]).
+    pub cancel: Option<crate::Cancel>,
 }
 
 /// A query's canvas, at the synthesis's top level: pixel `(x, y)` has its
@@ -648,6 +650,7 @@ fn run_query(
             levels: Vec::new(),
         });
     }
+    crate::io::check(&opts.cancel)?;
     let sopts = SynthOptions {
         seed: opts.seed,
         ..opts.synth.clone()

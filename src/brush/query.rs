@@ -14,7 +14,7 @@
 //! by widening the spacing, so a huge path cannot blow up either.
 
 use crate::error::{Error, Result};
-use crate::read::sketch::{QueryKind, Sketch};
+use crate::read::sketch::{profile_at, QueryKind, Sketch};
 use kurbo::{BezPath, PathEl, Point, Rect, Vec2};
 
 /// How query paths are resampled.
@@ -53,8 +53,14 @@ pub struct QuerySample {
     /// incoming to the outgoing step, i.e. signed curvature × spacing
     /// (positive turns from +x towards +y; 0 at both ends).
     pub turning: f64,
-    /// Intended ornament width here, in user units.
+    /// Intended ornament width here, in user units: the spine's
+    /// synthesis width (the matching's feature).
     pub width: f64,
+    /// The stroke's own width here over [`Self::width`] (its
+    /// `data-widths`; 1 where it has none): the ornament is synthesized at
+    /// `width` and its offsets across the spine are then scaled by this
+    /// ([`super::swell`]).
+    pub swell: f64,
     /// Arc length from the spine's start to this sample, in user units.
     pub dist_start: f64,
     /// Arc length from this sample to the spine's end, in user units.
@@ -70,6 +76,8 @@ pub struct QuerySpine {
     pub subpath: usize,
     /// The query's `data-style`, if any.
     pub style: Option<String>,
+    /// The query's `data-seed`, in place of the run's seed, if any.
+    pub seed: Option<u64>,
     /// The stroke width, in user units.
     pub width: f64,
     /// The actual arc length between samples, in user units (at most the
@@ -120,10 +128,15 @@ pub fn spines(sketch: &Sketch, opts: &QueryOptions) -> Result<QuerySet> {
             )));
         }
         let spacing = width * opts.spacing_in_widths;
-        for (k, poly) in flatten_subpaths(spine, spacing, opts)
-            .into_iter()
-            .enumerate()
-        {
+        let polys = flatten_subpaths(spine, spacing, opts);
+        // Where each subpath starts along the whole path, and its length,
+        // for the width profile's positions.
+        let lengths: Vec<f64> = polys.iter().map(|p| polyline_length(p)).collect();
+        let total: f64 = lengths.iter().sum();
+        let mut before = 0.0;
+        for (k, poly) in polys.into_iter().enumerate() {
+            let offset = before;
+            before += lengths[k];
             let what = format!("query {} subpath {k}", q.id);
             if !touches(&poly, sketch.view_box.inflate(width, width)) {
                 out.warnings
@@ -141,15 +154,27 @@ pub fn spines(sketch: &Sketch, opts: &QueryOptions) -> Result<QuerySet> {
                             opts.max_samples
                         ));
                     }
-                    let length = polyline_length(&poly);
+                    let length = lengths[k];
+                    let mut samples = features(&points, width, length);
+                    if let Some(w) = &q.widths {
+                        for s in &mut samples {
+                            let share = if total > 0.0 {
+                                (offset + s.dist_start) / total
+                            } else {
+                                0.0
+                            };
+                            s.swell = profile_at(w, share) / width;
+                        }
+                    }
                     out.spines.push(QuerySpine {
                         query_id: q.id.clone(),
                         subpath: k,
                         style: q.style.clone(),
+                        seed: q.seed,
                         width,
                         spacing: length / (points.len() - 1) as f64,
                         length,
-                        samples: features(&points, width, length),
+                        samples,
                     });
                 }
             }
@@ -360,6 +385,7 @@ pub fn features(points: &[Point], width: f64, length: f64) -> Vec<QuerySample> {
                 tangent: unit_tangent(prev, next),
                 turning,
                 width,
+                swell: 1.0,
                 dist_start: s,
                 dist_end: (length - s).max(0.0),
             }
@@ -522,6 +548,8 @@ mod tests {
         s.queries.push(crate::read::sketch::Query {
             id: "long".into(),
             style: None,
+            seed: None,
+            widths: None,
             kind: QueryKind::Path { spine, width: 2.0 },
         });
         let t = std::time::Instant::now();

@@ -77,6 +77,9 @@ pub struct FillOptions {
     /// unless the region pins another with `data-exemplar` (default
     /// `None`).
     pub exemplar: Option<String>,
+    /// Cancels the run from another thread: checked before each region;
+    /// the run then ends with [`Error::Cancelled`] (default `None`).
+    pub cancel: Option<crate::Cancel>,
 }
 
 impl Default for FillOptions {
@@ -87,6 +90,7 @@ impl Default for FillOptions {
             tolerance: 0.25,
             scale: 1.0,
             exemplar: None,
+            cancel: None,
         }
     }
 }
@@ -438,6 +442,7 @@ pub fn fill_sketch<'s>(
     let mut max_ppu = 1.0f64;
     let tally = crate::io::Tally::new("fill: regions filled", regions.len());
     for (qi, (q, outline, rule)) in regions.into_iter().enumerate() {
+        crate::io::check(&opts.cancel)?;
         if qi > 0 {
             tally.tick();
         }
@@ -495,7 +500,8 @@ pub fn fill_sketch<'s>(
             region.height(),
             region.area
         ));
-        let seed = crate::rng::hash(&[opts.seed, qi as u64]);
+        // A shape's own `data-seed` stands in for the run's.
+        let seed = crate::rng::hash(&[q.seed.unwrap_or(opts.seed), qi as u64]);
         let syn = prepared.synthesize(&region.direction, Some(&region.mask), seed);
         let mut layers = syn.layers;
         // Occlusion order: each layer extends under the layers above it.

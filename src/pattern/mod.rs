@@ -319,7 +319,8 @@ pub fn synthesize_sketch(
         .enumerate()
         .map(|(qi, q)| {
             let style = style_of(q)?;
-            let key = [opts.seed, qi as u64];
+            // A shape's own `data-seed` stands in for the run's.
+            let key = [q.seed.unwrap_or(opts.seed), qi as u64];
             let elements = match &q.kind {
                 QueryKind::Path { spine, width } => along_path(&style, spine, *width, opts, &key),
                 QueryKind::Region { outline, fill_rule } => {

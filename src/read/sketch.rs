@@ -6,8 +6,10 @@
 //! - a shape with a visible stroke and no fill is an **open query path**
 //!   (its geometry is the spine, its stroke width the intended width).
 //!
-//! A shape (or an ancestor group) may carry `data-style="NAME"`, and a
-//! filled one `data-exemplar="FILE"` (one swatch of its fill style). usvg
+//! A shape (or an ancestor group) may carry `data-style="NAME"`,
+//! `data-seed="N"` (its own seed, in place of the run's), and a filled one
+//! `data-exemplar="FILE"` (one swatch of its fill style). An open path may
+//! carry `data-widths` (its width along it, [`parse_widths`]). usvg
 //! drops unknown attributes, so the raw XML is read first with roxmltree
 //! (the parser usvg itself uses) and shapes without an `id` get a private
 //! one, mapped back here.
@@ -63,8 +65,82 @@ pub struct Query {
     pub id: String,
     /// The `data-style` of the shape or its nearest ancestor, if any.
     pub style: Option<String>,
+    /// The `data-seed` of the shape or its nearest ancestor: the seed of
+    /// this query's choices in place of the run's (`None`: the run's).
+    pub seed: Option<u64>,
+    /// An open path's width along it (`data-widths`), user units: values
+    /// at evenly spaced arc-length positions over the whole path, first at
+    /// its start, last at its end, linear between; `None` when the width
+    /// is the same all along (then it is [`QueryKind::Path`]'s `width`,
+    /// which is otherwise the mean of these over the length).
+    pub widths: Option<Vec<f64>>,
     /// Path or region, with its geometry.
     pub kind: QueryKind,
+}
+
+impl Query {
+    /// The width of an open path at `share` (0 = start, 1 = end) of its
+    /// length, user units; `None` for a region.
+    pub fn width_at(&self, share: f64) -> Option<f64> {
+        let QueryKind::Path { width, .. } = &self.kind else {
+            return None;
+        };
+        Some(match &self.widths {
+            Some(w) => profile_at(w, share),
+            None => *width,
+        })
+    }
+}
+
+/// The value at `share` (clamped to 0..=1) of a profile of values at
+/// evenly spaced positions, linear between them.
+pub(crate) fn profile_at(values: &[f64], share: f64) -> f64 {
+    match values {
+        [] => 0.0,
+        [one] => *one,
+        _ => {
+            let x = share.clamp(0.0, 1.0) * (values.len() - 1) as f64;
+            let i = (x.floor() as usize).min(values.len() - 2);
+            let f = x - i as f64;
+            values[i] * (1.0 - f) + values[i + 1] * f
+        }
+    }
+}
+
+/// Parses a `data-widths` attribute: one or more widths (positive, finite
+/// numbers separated by white space or commas) at evenly spaced positions
+/// along the path's length (SPEC.md, "Sketch SVG"); the reason in words
+/// when it is not one.
+pub fn parse_widths(text: &str) -> std::result::Result<Vec<f64>, String> {
+    let mut out = Vec::new();
+    for t in text
+        .split(|c: char| c.is_whitespace() || c == ',')
+        .filter(|t| !t.is_empty())
+    {
+        match t.parse::<f64>() {
+            Ok(v) if v.is_finite() && v > 0.0 => out.push(v),
+            Ok(_) => return Err(format!("width {t:?} is not a positive finite number")),
+            Err(_) => return Err(format!("{t:?} is not a number")),
+        }
+    }
+    if out.is_empty() {
+        return Err("no width given".into());
+    }
+    Ok(out)
+}
+
+/// The arc-length mean of a width profile ([`profile_at`]): the
+/// trapezoid rule over its evenly spaced values; the value itself when
+/// they are all equal.
+fn profile_mean(values: &[f64]) -> f64 {
+    match values {
+        [] => 0.0,
+        [one] => *one,
+        [first, .., last] if values.iter().all(|v| v == first) => *last,
+        [first, inner @ .., last] => {
+            (0.5 * (first + last) + inner.iter().sum::<f64>()) / (values.len() - 1) as f64
+        }
+    }
 }
 
 impl Query {
@@ -127,6 +203,8 @@ impl Sketch {
                 .map(|(i, (spine, width))| Query {
                     id: format!("q-{}", i + 1),
                     style: None,
+                    seed: None,
+                    widths: None,
                     kind: QueryKind::Path { spine, width },
                 })
                 .collect(),
@@ -167,6 +245,9 @@ impl Sketch {
                 QueryKind::Path { spine, width } => {
                     spine.apply_affine(to);
                     *width *= k;
+                    if let Some(w) = &mut q.widths {
+                        w.iter_mut().for_each(|v| *v *= k);
+                    }
                 }
                 QueryKind::Region { outline, .. } => outline.apply_affine(to),
             }
@@ -208,6 +289,8 @@ pub fn parse(data: &[u8]) -> Result<Sketch> {
     let mut read = Read {
         styles: &pre.styles,
         exemplars: &pre.exemplars,
+        seeds: &pre.seeds,
+        widths: &pre.widths,
         elements: &pre.elements,
         placed: std::collections::BTreeSet::new(),
         backdrop: Backdrop {
@@ -216,7 +299,7 @@ pub fn parse(data: &[u8]) -> Result<Sketch> {
             places: BTreeMap::new(),
         },
     };
-    walk(tree.root(), to_user, &mut read, &mut sketch);
+    walk(tree.root(), to_user, &mut read, &mut sketch)?;
     if sketch.queries.len() > MAX_QUERIES {
         return Err(Error::invalid(format!(
             "{} shapes to decorate, more than the limit of {MAX_QUERIES}",
@@ -236,6 +319,10 @@ struct Preprocessed {
     styles: BTreeMap<String, String>,
     /// element id → data-exemplar
     exemplars: BTreeMap<String, String>,
+    /// element id → data-seed (of the shape or its nearest ancestor)
+    seeds: BTreeMap<String, String>,
+    /// element id → data-widths (of the shape itself)
+    widths: BTreeMap<String, String>,
     /// element id → where it stands in the text, for elements that can be
     /// replaced in place (drawn where they stand, their id unique)
     elements: BTreeMap<String, Element>,
@@ -256,6 +343,8 @@ struct Element {
 struct Read<'a> {
     styles: &'a BTreeMap<String, String>,
     exemplars: &'a BTreeMap<String, String>,
+    seeds: &'a BTreeMap<String, String>,
+    widths: &'a BTreeMap<String, String>,
     elements: &'a BTreeMap<String, Element>,
     /// The elements a query has already taken the place of.
     placed: std::collections::BTreeSet<String>,
@@ -281,6 +370,8 @@ fn preprocess(text: &str) -> Result<Preprocessed> {
         .to_string();
     let mut styles = BTreeMap::new();
     let mut exemplars = BTreeMap::new();
+    let mut seeds = BTreeMap::new();
+    let mut widths = BTreeMap::new();
     let mut elements = BTreeMap::new();
     let mut seen = std::collections::BTreeSet::new();
     let mut twice = std::collections::BTreeSet::new();
@@ -322,6 +413,12 @@ fn preprocess(text: &str) -> Result<Preprocessed> {
         if let Some(style) = style {
             styles.insert(id.clone(), style.to_string());
         }
+        if let Some(seed) = inherited("data-seed") {
+            seeds.insert(id.clone(), seed.to_string());
+        }
+        if let Some(w) = node.attribute("data-widths") {
+            widths.insert(id.clone(), w.to_string());
+        }
         let referenced = node
             .ancestors()
             .any(|a| REFERENCED.contains(&a.tag_name().name()));
@@ -349,6 +446,8 @@ fn preprocess(text: &str) -> Result<Preprocessed> {
         aspect,
         styles,
         exemplars,
+        seeds,
+        widths,
         elements,
         end: closing_tag(text, root.range()),
     })
@@ -411,15 +510,16 @@ fn viewport_to_user(vb: Rect, width: f64, height: f64, aspect: &str) -> Affine {
     to_viewport.inverse()
 }
 
-fn walk(group: &usvg::Group, to_user: Affine, read: &mut Read, sk: &mut Sketch) {
+fn walk(group: &usvg::Group, to_user: Affine, read: &mut Read, sk: &mut Sketch) -> Result<()> {
     for node in group.children() {
         match node {
-            usvg::Node::Group(g) => walk(g, to_user, read, sk),
+            usvg::Node::Group(g) => walk(g, to_user, read, sk)?,
             usvg::Node::Image(_) => sk.notes.push("an image is ignored".into()),
             usvg::Node::Text(_) => sk.notes.push("a text element is ignored".into()),
-            usvg::Node::Path(p) => add_path(p, to_user, read, sk),
+            usvg::Node::Path(p) => add_path(p, to_user, read, sk)?,
         }
     }
+    Ok(())
 }
 
 impl Read<'_> {
@@ -444,7 +544,7 @@ impl Read<'_> {
     }
 }
 
-fn add_path(p: &usvg::Path, to_user: Affine, read: &mut Read, sk: &mut Sketch) {
+fn add_path(p: &usvg::Path, to_user: Affine, read: &mut Read, sk: &mut Sketch) -> Result<()> {
     let label = if p.id().is_empty() || p.id().starts_with(PRIVATE_ID) {
         "an unnamed shape".to_string()
     } else {
@@ -452,7 +552,7 @@ fn add_path(p: &usvg::Path, to_user: Affine, read: &mut Read, sk: &mut Sketch) {
     };
     if !p.is_visible() {
         sk.notes.push(format!("{label} is invisible and ignored"));
-        return;
+        return Ok(());
     }
     let abs = to_user * affine_of(p.abs_transform());
     let geom = abs * to_bezpath(p.data(), usvg::Transform::identity());
@@ -464,13 +564,13 @@ fn add_path(p: &usvg::Path, to_user: Affine, read: &mut Read, sk: &mut Sketch) {
         sk.warnings.push(format!(
             "{label} has a coordinate of {v:e}, beyond ±{MAX_COORD:e} units, and is skipped"
         ));
-        return;
+        return Ok(());
     }
     if geom.elements().is_empty() || geom.bounding_box().area() == 0.0 && geom.perimeter(0.1) == 0.0
     {
         sk.warnings
             .push(format!("{label} has no length and is skipped"));
-        return;
+        return Ok(());
     }
     let n = sk.queries.len() + 1;
     let id = if p.id().is_empty() || p.id().starts_with(PRIVATE_ID) {
@@ -479,6 +579,15 @@ fn add_path(p: &usvg::Path, to_user: Affine, read: &mut Read, sk: &mut Sketch) {
         p.id().to_string()
     };
     let style = read.styles.get(p.id()).cloned();
+    let seed = match read.seeds.get(p.id()) {
+        Some(t) => Some(t.trim().parse::<u64>().map_err(|_| {
+            Error::invalid(format!(
+                "shape {id}: data-seed {t:?} is not a whole number from 0 to {}",
+                u64::MAX
+            ))
+        })?),
+        None => None,
+    };
     read.place(&id, p.id(), abs);
     if let Some(fill) = p.fill() {
         let fill_rule = match fill.rule() {
@@ -488,9 +597,15 @@ fn add_path(p: &usvg::Path, to_user: Affine, read: &mut Read, sk: &mut Sketch) {
         if let Some(e) = read.exemplars.get(p.id()) {
             sk.exemplars.insert(id.clone(), e.clone());
         }
+        if read.widths.contains_key(p.id()) {
+            sk.notes
+                .push(format!("shape {id} is filled; its data-widths are ignored"));
+        }
         sk.queries.push(Query {
             id,
             style,
+            seed,
+            widths: None,
             kind: QueryKind::Region {
                 outline: geom,
                 fill_rule,
@@ -504,11 +619,30 @@ fn add_path(p: &usvg::Path, to_user: Affine, read: &mut Read, sk: &mut Sketch) {
         if width.is_nan() || width <= 0.0 {
             sk.warnings
                 .push(format!("{label} has a zero stroke width and is skipped"));
-            return;
+            return Ok(());
         }
+        // data-widths are scaled like the stroke width and replace it: the
+        // path's width is then their mean over its length.
+        let (width, widths) = match read.widths.get(p.id()) {
+            Some(t) => {
+                let mut w = parse_widths(t)
+                    .map_err(|r| Error::invalid(format!("shape {id}: data-widths: {r}")))?;
+                w.iter_mut().for_each(|v| *v *= scale);
+                if w.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
+                    return Err(Error::invalid(format!(
+                        "shape {id}: data-widths: a width is out of range once transformed"
+                    )));
+                }
+                let mean = profile_mean(&w);
+                (mean, w.iter().any(|v| *v != mean).then_some(w))
+            }
+            None => (width, None),
+        };
         sk.queries.push(Query {
             id,
             style,
+            seed,
+            widths,
             kind: QueryKind::Path { spine: geom, width },
         });
     } else {
@@ -516,6 +650,7 @@ fn add_path(p: &usvg::Path, to_user: Affine, read: &mut Read, sk: &mut Sketch) {
             "{label} has neither fill nor stroke and is ignored"
         ));
     }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -560,6 +695,36 @@ mod tests {
         assert_eq!(s.exemplars.get("c").map(String::as_str), Some("a.svg"));
         assert_eq!(s.queries[1].style.as_deref(), Some("s"));
         assert!(!s.exemplars.contains_key("q-3"));
+    }
+
+    /// `data-widths` are scaled like the stroke width, their mean over the
+    /// length becomes the path's width, equal widths are none, and a
+    /// group's `data-seed` reaches its shapes.
+    #[test]
+    fn data_widths_and_seeds_are_read() {
+        let svg = r##"<svg xmlns="http://www.w3.org/2000/svg" width="200" height="100">
+            <g transform="scale(2)" data-seed="9">
+              <path id="a" d="M10 10 L90 10" stroke="#000" stroke-width="5" fill="none" data-widths="2, 4 8"/>
+            </g>
+            <path id="b" d="M10 50 L190 50" stroke="#000" stroke-width="5" fill="none" data-widths="6 6 6" data-seed="3"/>
+            <rect id="c" x="10" y="60" width="20" height="20" fill="#000" data-widths="1 2"/>
+        </svg>"##;
+        let s = parse(svg.as_bytes()).unwrap();
+        let q = &s.queries;
+        assert_eq!(q[0].widths, Some(vec![4.0, 8.0, 16.0]));
+        assert!(matches!(q[0].kind, QueryKind::Path { width, .. } if (width - 9.0).abs() < 1e-12));
+        assert_eq!(q[0].width_at(0.25), Some(6.0));
+        assert_eq!(q[0].seed, Some(9));
+        assert_eq!(q[1].widths, None);
+        assert!(matches!(q[1].kind, QueryKind::Path { width, .. } if width == 6.0));
+        assert_eq!(q[1].seed, Some(3));
+        assert_eq!(q[2].widths, None);
+        assert!(s
+            .notes
+            .iter()
+            .any(|n| n.contains("shape c") && n.contains("data-widths")));
+        assert_eq!(profile_at(&[1.0, 3.0], 2.0), 3.0);
+        assert_eq!(profile_mean(&[1.0, 3.0, 1.0]), 2.0);
     }
 
     /// A shape whose coordinates run past `MAX_COORD` (an arc of 1e308, a

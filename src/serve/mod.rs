@@ -10,6 +10,7 @@
 //! | `GET /api/styles` | every style of the library: name, kind, exemplar count |
 //! | `GET /api/styles/NAME/exemplars/I` | exemplar I of style NAME (SVG or PNG bytes) |
 //! | `POST /api/synthesize` | a sketch, a mode, a style and a seed → the result SVG |
+//! | `POST /api/cancel` | a lane and a generation: the lane's older syntheses end (409) |
 //! | `POST /api/uploads` | a new upload of exemplars → its id |
 //! | `POST /api/uploads/ID/files` | one exemplar file (SVG, PNG or JPEG) |
 //! | `POST /api/uploads/ID/style/KIND` | the upload made a style `mine-ID` of KIND, with its check's warnings |
@@ -201,6 +202,10 @@ fn route(state: &synth::State, request: &mut Request) -> Reply {
             Ok(bytes) => state.synthesize(&bytes),
             Err(reply) => reply,
         },
+        (Method::Post, ["api", "cancel"]) => match body(request) {
+            Ok(bytes) => state.cancel(&bytes),
+            Err(reply) => reply,
+        },
         (Method::Post, ["api", "uploads"]) => state.uploads.create(),
         (Method::Get, ["api", "uploads", id, "zip"]) => match id.parse() {
             Ok(id) => state.uploads.zip(id),
@@ -215,9 +220,10 @@ fn route(state: &synth::State, request: &mut Request) -> Reply {
             Ok(id) => state.make_style(id, kind),
             Err(_) => Reply::error(400, format!("upload id {id:?} is not a number")),
         },
-        (_, ["api", "styles", ..]) | (_, ["api", "synthesize"]) | (_, ["api", "uploads", ..]) => {
-            Reply::error(405, format!("{path}: wrong method"))
-        }
+        (_, ["api", "styles", ..])
+        | (_, ["api", "synthesize"])
+        | (_, ["api", "cancel"])
+        | (_, ["api", "uploads", ..]) => Reply::error(405, format!("{path}: wrong method")),
         _ => Reply::error(404, format!("{path}: no such page")),
     }
 }

@@ -2,12 +2,14 @@
 //! exact name from the library's listing), and syntheses through the
 //! library's face, one per request, at most [`slots`] at once, a stale
 //! one (superseded by a newer generation of the same lane) dropped before
-//! it starts.
+//! it starts or cancelled while it runs (the modes' [`Cancel`] handle,
+//! checked between their stages and queries): 409 either way.
 
 use super::Reply;
 use flourish::{
-    BrushOptions, DecorateOptions, Decoration, FillOptions, Library, Output, PatternOptions,
-    QueryKind, Refinement, Sketch, Style, StyleEntry, StyleKind, StyleOptions, Styles,
+    BrushOptions, Cancel, DecorateOptions, Decoration, FillOptions, Library, Output,
+    PatternOptions, QueryKind, Refinement, Sketch, Style, StyleEntry, StyleKind, StyleOptions,
+    Styles,
 };
 use serde::Deserialize;
 use serde_json::json;
@@ -70,8 +72,8 @@ pub struct State {
     bound: SocketAddr,
     /// Styles loaded so far, by name.
     styles: Mutex<HashMap<String, Style>>,
-    /// The newest generation seen per lane.
-    lanes: Mutex<HashMap<String, u64>>,
+    /// The newest generation seen per lane and its running syntheses.
+    lanes: Mutex<HashMap<String, Lane>>,
     /// Styles made on the page from dropped exemplars.
     pub uploads: super::upload::Uploads,
     /// The listing entries of those styles, in the order they were made.
@@ -79,6 +81,43 @@ pub struct State {
     /// Synthesis slots handed out first come, first served, and the
     /// condition to wait for one's turn on.
     queue: (Mutex<Queue>, Condvar),
+}
+
+/// One lane's generations: the newest seen, and the syntheses running
+/// with their cancel handles.
+#[derive(Default)]
+struct Lane {
+    /// The newest generation seen.
+    newest: u64,
+    /// (generation, handle) of each synthesis running in this lane.
+    running: Vec<(u64, Cancel)>,
+}
+
+/// A synthesis registered in its lane; taken out when dropped.
+struct Running<'a> {
+    state: &'a State,
+    lane: &'a str,
+    cancel: Cancel,
+}
+
+impl Drop for Running<'_> {
+    fn drop(&mut self) {
+        if let Ok(mut lanes) = self.state.lanes.lock() {
+            if let Some(l) = lanes.get_mut(self.lane) {
+                l.running.retain(|(_, c)| *c != self.cancel);
+            }
+        }
+    }
+}
+
+/// The body of `POST /api/cancel`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CancelRequest {
+    /// The lane whose older syntheses end.
+    lane: String,
+    /// The generation that supersedes them.
+    generation: u64,
 }
 
 /// The tickets of the synthesis queue.
@@ -302,7 +341,8 @@ impl State {
         Some(Slot(self))
     }
 
-    /// Records `generation` for `lane`; whether it is the newest so far.
+    /// Records `generation` for `lane` and cancels the lane's running
+    /// syntheses of older generations; whether it is the newest so far.
     fn newest(&self, lane: &str, generation: u64) -> bool {
         let Ok(mut lanes) = self.lanes.lock() else {
             return true;
@@ -310,9 +350,52 @@ impl State {
         if lanes.len() >= MAX_LANES && !lanes.contains_key(lane) {
             lanes.clear();
         }
-        let seen = lanes.entry(lane.to_string()).or_insert(generation);
-        *seen = (*seen).max(generation);
-        *seen == generation
+        let l = lanes.entry(lane.to_string()).or_insert(Lane {
+            newest: generation,
+            running: Vec::new(),
+        });
+        l.newest = l.newest.max(generation);
+        for (g, c) in &l.running {
+            if *g < l.newest {
+                c.cancel();
+            }
+        }
+        l.newest == generation
+    }
+
+    /// Registers a synthesis of `generation` in `lane` with its handle,
+    /// so a newer generation cancels it.
+    fn register<'a>(&'a self, lane: &'a str, generation: u64, cancel: &Cancel) -> Running<'a> {
+        if let Ok(mut lanes) = self.lanes.lock() {
+            lanes
+                .entry(lane.to_string())
+                .or_default()
+                .running
+                .push((generation, cancel.clone()));
+        }
+        Running {
+            state: self,
+            lane,
+            cancel: cancel.clone(),
+        }
+    }
+
+    /// `POST /api/cancel`: `{"lane", "generation"}` supersedes the lane's
+    /// older requests, queued or running (the page sends it when the
+    /// drawing changes under a synthesis of the whole of it).
+    pub fn cancel(&self, body: &[u8]) -> Reply {
+        let req: CancelRequest = match serde_json::from_slice(body) {
+            Ok(r) => r,
+            Err(e) => return Reply::error(400, format!("malformed request: {e}")),
+        };
+        if req.lane.len() > MAX_LANE {
+            return Reply::error(400, format!("lane is longer than {MAX_LANE} bytes"));
+        }
+        self.newest(&req.lane, req.generation);
+        Reply::json(
+            200,
+            &json!({ "lane": req.lane, "generation": req.generation }),
+        )
     }
 
     /// `POST /api/synthesize`: parses the request, waits for a slot,
@@ -335,6 +418,11 @@ impl State {
         let Some(_slot) = self.slot() else {
             return Reply::error(503, "the server is shutting down");
         };
+        let cancel = Cancel::new();
+        let _running = req
+            .lane
+            .as_deref()
+            .map(|lane| self.register(lane, req.generation, &cancel));
         if let Some(lane) = &req.lane {
             if !self.newest(lane, req.generation) {
                 return Reply::error(409, "superseded by a newer request for the same stroke");
@@ -345,7 +433,7 @@ impl State {
             Ok(s) => s,
             Err(e) => return Reply::error(422, format!("sketch: {e}")),
         };
-        let out = match self.run(&req, &sketch) {
+        let out = match self.run(&req, &sketch, &cancel) {
             Ok(out) => out,
             Err(reply) => return reply,
         };
@@ -361,8 +449,15 @@ impl State {
     }
 
     /// Runs the request's mode on `sketch`.
-    fn run(&self, req: &SynthRequest, sketch: &Sketch) -> Result<Output, Reply> {
-        let fail = |e: flourish::Error| Reply::error(422, e.to_string());
+    fn run(&self, req: &SynthRequest, sketch: &Sketch, cancel: &Cancel) -> Result<Output, Reply> {
+        let fail = |e: flourish::Error| match e.cause() {
+            flourish::Error::Cancelled => Reply::error(
+                409,
+                "cancelled: superseded by a newer request for the same stroke",
+            ),
+            _ => Reply::error(422, e.to_string()),
+        };
+        let cancel = Some(cancel.clone());
         let style_of = |kind: StyleKind| -> Result<Style, Reply> {
             let name = req
                 .style
@@ -387,6 +482,7 @@ impl State {
                 let opts = BrushOptions {
                     seed,
                     refine,
+                    cancel,
                     ..BrushOptions::default()
                 };
                 flourish::brush(sketch, &style, &opts).map_err(fail)
@@ -396,6 +492,7 @@ impl State {
                 let named = self.named(sketch, |k| matches!(k, QueryKind::Region { .. }))?;
                 let opts = FillOptions {
                     seed,
+                    cancel,
                     ..FillOptions::default()
                 };
                 flourish::fill(sketch, Styles::new(&style, &named), &opts).map_err(fail)
@@ -414,10 +511,12 @@ impl State {
                 let opts = DecorateOptions {
                     brush: BrushOptions {
                         seed,
+                        cancel: cancel.clone(),
                         ..BrushOptions::default()
                     },
                     fill: FillOptions {
                         seed,
+                        cancel,
                         ..FillOptions::default()
                     },
                     pattern: PatternOptions {

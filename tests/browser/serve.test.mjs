@@ -177,6 +177,10 @@ test('brush strokes drawn with a pen equal the command line, with pressure width
   assert.ok(Math.max(...widths) > 1.5 * Math.min(...widths), `pressure sets the width: ${widths}`);
   const want = cli('brush', 'vine', 0, sketch);
   assert.equal(await shown(), want, 'the board shows what flourish brush gives');
+  // The ornament follows the pressure: without its widths the same sketch
+  // gives other outlines.
+  const flat = sketch.replace(/ data-widths="[^"]+"/g, '');
+  assert.notEqual(cli('brush', 'vine', 0, flat), want, 'the widths change the ornament');
   assert.equal(await downloaded('#export-result'), want, 'exported result = flourish brush');
   // Each stroke's own result has the same ornament (rounded alike or finer).
   const own = await page.evaluate(() => window.flourish.strokes.map((s) => s.svg));
@@ -190,9 +194,47 @@ test('brush strokes drawn with a pen equal the command line, with pressure width
   }
 });
 
-test('another one takes the next seed, and undo takes it back', { timeout: 120000 }, async () => {
+test('another one draws one stroke again, the others stay; undo takes it back', { timeout: 120000 }, async () => {
   const before = await page.evaluate(() => window.flourish.strokes.map((s) => s.svg));
+  const n = before.length;
+  assert.ok(n >= 2, 'strokes from the first test');
   await page.click('#another');
+  await settled(0);
+  let after = await page.evaluate(() => window.flourish.strokes.map((s) => s.svg));
+  assert.deepEqual(after.slice(0, n - 1), before.slice(0, n - 1), 'the other strokes keep their ornament');
+  assert.notEqual(after[n - 1], before[n - 1], 'the last stroke is another one');
+  let sketch = await downloaded('#export-sketch');
+  assert.equal((sketch.match(/data-seed="1"/g) || []).length, 1, 'one stroke has a seed of its own');
+  assert.equal(await shown(), cli('brush', 'vine', 0, sketch));
+  assert.equal(await downloaded('#export-result'), cli('brush', 'vine', 0, sketch));
+  // The another tool picks the first stroke.
+  await page.check('input[name=tool][value=another]');
+  const first = await page.evaluate(() => window.flourish.strokes[0].id);
+  const [x, y] = await page.evaluate((id) => {
+    const r = document.querySelector(`#sketch path[data-stroke="${id}"]`).getBoundingClientRect();
+    return [r.x + r.width / 2, r.y + r.height / 2];
+  }, first);
+  const hit = await page.evaluate(([x, y]) => document.elementFromPoint(x, y)?.closest('[data-stroke]')?.dataset.stroke, [x, y]);
+  assert.equal(hit, first, 'the first stroke is under the pointer');
+  await page.mouse.click(x, y);
+  await settled(0);
+  const again = await page.evaluate(() => window.flourish.strokes.map((s) => s.svg));
+  assert.notEqual(again[0], after[0], 'the picked stroke is another one');
+  assert.deepEqual(again.slice(1), after.slice(1), 'the others stay');
+  await page.click('#undo');
+  await settled(0);
+  await page.check('input[name=tool][value=draw]');
+  await page.click('#undo');
+  await settled(0);
+  after = await page.evaluate(() => window.flourish.strokes.map((s) => s.svg));
+  assert.deepEqual(after, before, 'undo takes the seed back');
+  sketch = await downloaded('#export-sketch');
+  assert.ok(!sketch.includes('data-seed'), 'no seed of its own left');
+});
+
+test('reseed all takes the next seed for the drawing, and undo takes it back', { timeout: 120000 }, async () => {
+  const before = await page.evaluate(() => window.flourish.strokes.map((s) => s.svg));
+  await page.click('#reseed');
   await settled(0);
   assert.equal(await page.textContent('#seed'), '1');
   const after = await page.evaluate(() => window.flourish.strokes.map((s) => s.svg));
