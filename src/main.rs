@@ -1000,11 +1000,13 @@ impl Ticker {
             let tick = std::time::Duration::from_millis(100);
             let start = std::time::Instant::now();
             let after = Ticker::after();
+            // Parked, not asleep: dropping the ticker unparks it, so a
+            // run that ends early does not wait out a tick.
             while start.elapsed() < after {
                 if stop.load(Ordering::Relaxed) {
                     return;
                 }
-                std::thread::sleep(tick);
+                std::thread::park_timeout(tick.min(after - start.elapsed()));
             }
             let terminal = std::io::stderr().is_terminal();
             let spinner = terminal.then(|| {
@@ -1037,7 +1039,7 @@ impl Ticker {
                         shown = stage;
                     }
                 }
-                std::thread::sleep(tick);
+                std::thread::park_timeout(tick);
             }
             if let Some(s) = spinner {
                 s.finish_and_clear();
@@ -1054,6 +1056,7 @@ impl Drop for Ticker {
     fn drop(&mut self) {
         self.done.store(true, std::sync::atomic::Ordering::Relaxed);
         if let Some(t) = self.thread.take() {
+            t.thread().unpark();
             let _ = t.join();
         }
     }
