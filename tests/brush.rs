@@ -24,7 +24,7 @@ fn cli_writes_variations_and_fails_cleanly() {
     let bin = env!("CARGO_BIN_EXE_flourish");
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("o.svg");
-    let cache = std::env::temp_dir().join("flourish-test-cache");
+    let cache = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("target/test-cache");
     let run = |args: &[&str]| std::process::Command::new(bin).args(args).output().unwrap();
     let sample = root().join("samples/brush/short.svg");
     let r = run(&[
@@ -185,7 +185,7 @@ fn brush_on_a_pencil_photo_covers_the_drawn_lines() {
     let width = 20.0;
     let sketch = flourish::sketch_from_drawing(&png, Some(width)).expect("the photo reads");
     let opts = flourish::StyleOptions {
-        cache_dir: Some(std::env::temp_dir().join("flourish-test-cache")),
+        cache_dir: Some(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("target/test-cache")),
         ..flourish::StyleOptions::default()
     };
     let vine = flourish::Library::shipped()

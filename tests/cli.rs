@@ -1768,7 +1768,7 @@ fn brush_variations_with_out_dir_name_each_variation() {
     };
     let a = sketch("wave", "M20 60 C 60 10, 120 100, 180 40");
     let b = sketch("line", "M20 50 L180 50");
-    let cache = std::env::temp_dir().join("flourish-test-cache");
+    let cache = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("target/test-cache");
     let o = flourish(&[
         "brush",
         "--style",
@@ -1934,7 +1934,7 @@ fn brush_thin_diagonal_stroke_is_brushed_in_pieces() {
 <path d="M2 2 L198 198" fill="none" stroke="#000" stroke-width="0.4"/></svg>"##,
     );
     let out = t.path().join("out.svg");
-    let cache = std::env::temp_dir().join("flourish-test-cache");
+    let cache = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("target/test-cache");
     let o = flourish_guarded(
         t.path(),
         &[
