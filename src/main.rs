@@ -1001,11 +1001,13 @@ impl Ticker {
             let tick = std::time::Duration::from_millis(100);
             let start = std::time::Instant::now();
             let after = Ticker::after();
+            // Parked, not asleep: dropping the ticker unparks it, so a
+            // run that ends early does not wait out a tick.
             while start.elapsed() < after {
                 if stop.load(Ordering::Relaxed) {
                     return;
                 }
-                std::thread::sleep(tick);
+                std::thread::park_timeout(tick.min(after - start.elapsed()));
             }
             let terminal = std::io::stderr().is_terminal();
             let spinner = terminal.then(|| {
@@ -1038,7 +1040,7 @@ impl Ticker {
                         shown = stage;
                     }
                 }
-                std::thread::sleep(tick);
+                std::thread::park_timeout(tick);
             }
             if let Some(s) = spinner {
                 s.finish_and_clear();
@@ -1055,6 +1057,7 @@ impl Drop for Ticker {
     fn drop(&mut self) {
         self.done.store(true, std::sync::atomic::Ordering::Relaxed);
         if let Some(t) = self.thread.take() {
+            t.thread().unpark();
             let _ = t.join();
         }
     }

@@ -45,7 +45,7 @@ fn run(program: &Path, args: &[&str], cache: &Path) {
 /// `flourish CLI… -o OUT`.
 fn both(name: &str, args: &[&str], cli: &[&str]) -> (Vec<u8>, Vec<u8>) {
     let dir = tempfile::tempdir().expect("temp dir");
-    let cache = std::env::temp_dir().join("flourish-test-cache");
+    let cache = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("target/test-cache");
     let (ex, cmd) = (dir.path().join("example.svg"), dir.path().join("cli.svg"));
     let mut ex_args = args.to_vec();
     ex_args.push(ex.to_str().expect("utf-8 path"));

@@ -87,7 +87,7 @@ fn assert_none_failed(mode: &str, failures: &[String]) {
 fn brush() {
     let lib = Library::shipped();
     let load = StyleOptions {
-        cache_dir: Some(std::env::temp_dir().join("flourish-test-cache")),
+        cache_dir: Some(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("target/test-cache")),
         ..StyleOptions::default()
     };
     let mut failures = Vec::new();

@@ -83,7 +83,7 @@ fn check(name: &str, run: impl Fn(&Sketch) -> Output, sample: &str) {
 fn a_sketch_in_mm_or_pt_gives_the_px_result_scaled() {
     let lib = Library::shipped();
     let load = StyleOptions {
-        cache_dir: Some(std::env::temp_dir().join("flourish-test-cache")),
+        cache_dir: Some(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("target/test-cache")),
         ..StyleOptions::default()
     };
     let stipple = lib.load("stipple", &load).expect("stipple");

@@ -320,11 +320,14 @@ pub(super) fn plan(mode: &'static str, art: &Path, root: &Path) -> Vec<Plan> {
 
 type Outcome = crate::Result<(String, Vec<Check>)>;
 
+/// Loads a style with its analysis cached in this checkout's
+/// `target/gallery-cache`: a cache shared by several checkouts could hand
+/// one the analysis another's code made.
 fn load(style: &Path) -> crate::Result<Style> {
     Style::load(
         style,
         &StyleOptions {
-            cache_dir: Some(std::env::temp_dir().join("flourish-gallery-cache")),
+            cache_dir: Some(Path::new(env!("CARGO_MANIFEST_DIR")).join("target/gallery-cache")),
             ..StyleOptions::default()
         },
     )

@@ -34,6 +34,11 @@ impl Bitmap {
         }
     }
 
+    /// How many pixels are ink.
+    pub fn ink_count(&self) -> usize {
+        self.flags.iter().map(|&f| usize::from(f)).sum()
+    }
+
     /// The ink of coverage `cov`: pixels with coverage ≥ ½ (the rule of
     /// [`crate::outline::smooth`] and [`crate::outline::corridor`]).
     pub fn from_coverage(cov: &Coverage) -> Self {

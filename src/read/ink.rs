@@ -295,6 +295,7 @@ pub fn read_traceable(bytes: &[u8], opts: &ImageOptions) -> Result<Traceable> {
         return read_svg(bytes, opts).map(Traceable::Field);
     }
     let (coverage, lighting) = raster_coverage(bytes, opts)?;
+    something_to_trace(&coverage)?;
     let (w, h, layers) = match coverage {
         RasterCoverage::Binary { w, h, color, bits } => (
             w,
@@ -319,6 +320,36 @@ pub fn read_traceable(bytes: &[u8], opts: &ImageOptions) -> Result<Traceable> {
         layers,
         notes: lighting.iter().map(|l| l.note()).collect(),
     }))
+}
+
+/// Refuses a picture with nothing to trace: no ink anywhere (blank
+/// paper, a photo of it, or nothing but transparency), or one ink that
+/// covers every pixel (a solid image has no shape to outline). Ink is
+/// coverage ≥ ½, as the outlines read it.
+fn something_to_trace(coverage: &RasterCoverage) -> Result<()> {
+    let (pixels, inked, layers) = match coverage {
+        RasterCoverage::Binary { w, h, bits, .. } => (w * h, bits.ink_count(), 1),
+        RasterCoverage::Layers { w, h, layers } => {
+            let inked = layers
+                .iter()
+                .map(|(_, cov)| cov.data().iter().filter(|&&c| c >= 0.5).count())
+                .max()
+                .unwrap_or(0);
+            (w * h, inked, layers.len())
+        }
+    };
+    if inked == 0 {
+        return Err(Error::Invalid(
+            "nothing to trace: no ink on the page (blank paper?)".into(),
+        ));
+    }
+    if layers == 1 && inked == pixels {
+        return Err(Error::Invalid(
+            "nothing to trace: one ink covers the whole picture (a solid image has no shapes)"
+                .into(),
+        ));
+    }
+    Ok(())
 }
 
 /// Raster bytes (PNG, JPEG, …) read as ink, as `read` reads them.

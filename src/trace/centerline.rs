@@ -33,6 +33,10 @@ const SPUR_FLOOR: f64 = 3.0;
 /// angle: 40°.
 const BRIDGE_COS: f64 = 0.766;
 
+/// Slack on the bridging distance (px): a soft pencil tip fades under
+/// half coverage up to half a pixel early on each side.
+const BRIDGE_SLACK_PX: f64 = 1.0;
+
 /// A traced line: its centre as a polyline and its width, in pixels.
 #[derive(Clone, Debug)]
 pub struct Line {
@@ -677,8 +681,11 @@ fn extend_ends(points: &mut Vec<Point>, first: bool, last: bool, lw: f64, cov: &
 }
 
 /// [`extend_ends`] at the last point. The skeleton's last line width
-/// (where thinning frays it) is set aside, and the direction taken over
-/// the two widths before it.
+/// (where thinning frays it) is set aside, and the walk starts in the
+/// direction taken over the two widths before it; each step keeps to the
+/// middle of the ink across the walk (the coverage-weighted centre within
+/// ±¾ of a width, moved at most [`STEER_PX`] per step), so a curving line
+/// is followed to its tip rather than left along a tangent.
 fn extend_last(points: &mut Vec<Point>, lw: f64, cov: &Coverage) {
     if length(points) < 3.0 * lw {
         return;
@@ -696,41 +703,75 @@ fn extend_last(points: &mut Vec<Point>, lw: f64, cov: &Coverage) {
         .find(|p| p.distance(from) >= 2.0 * lw)
         .copied()
         .unwrap_or(points[0]);
-    let d = unit(from - back);
+    let mut d = unit(from - back);
     if d == Vec2::ZERO {
         return;
     }
+    let step = 0.25;
+    let across: Vec<f64> = {
+        let k = (0.75 * lw / 0.5).ceil() as i32;
+        (-k..=k).map(|j| f64::from(j) * 0.5).collect()
+    };
     // The tip is where the coverage, the most of three samples across
     // the line (±0.2 widths), stays under ½ for a pixel, so a grain of
     // paper inside the ink does not stop the walk.
-    let (mut s, mut paper) = (0.0, 0.0);
-    while s < 4.0 * lw + 4.0 && paper < 1.0 {
-        let p = from + d * (s + 0.25);
-        let side = Vec2::new(-d.y, d.x) * (0.2 * lw);
-        let c = [p - side, p, p + side]
+    let mut walked = vec![from];
+    let (mut p, mut paper) = (from, 0.0);
+    while (walked.len() as f64) * step < 4.0 * lw + 4.0 && paper < 1.0 {
+        let n = Vec2::new(-d.y, d.x);
+        let mut q = p + d * step;
+        let (mut weight, mut moment) = (0.0, 0.0);
+        for &o in &across {
+            let c = f64::from(cov.sample((q + n * o).x, (q + n * o).y));
+            if c >= 0.25 {
+                weight += c;
+                moment += c * o;
+            }
+        }
+        if weight > 0.0 {
+            q += n * (moment / weight).clamp(-STEER_PX, STEER_PX);
+        }
+        let side = n * (0.2 * lw);
+        let c = [q - side, q, q + side]
             .iter()
-            .map(|q| cov.sample(q.x, q.y))
+            .map(|r| cov.sample(r.x, r.y))
             .fold(0.0f32, f32::max);
         if c < 0.5 {
-            paper += 0.25;
+            paper += step;
         } else {
             paper = 0.0;
         }
-        s += 0.25;
+        let turned = unit(q - p);
+        if turned != Vec2::ZERO {
+            d = unit(d * 3.0 + turned);
+        }
+        p = q;
+        walked.push(p);
     }
+    // Back off the paper walked and half a width (the round cap).
+    let back_off = ((paper + 0.5 * lw) / step).round() as usize;
+    let Some(last) = walked.len().checked_sub(back_off + 1) else {
+        return;
+    };
+    let tip = walked[last];
     // Only ever carried on: a grain of paper at a thin line's end must not
     // cut the skeleton back.
-    let s = s - paper - 0.5 * lw;
-    if s > (end - from).dot(d) + 0.25 {
+    if tip.distance(from) > end.distance(from) + 0.25 {
         points.truncate(keep + 1);
-        points.push(from + d * s);
+        points.extend(walked[1..=last].iter().step_by(4).copied());
+        if points.last() != Some(&tip) {
+            points.push(tip);
+        }
     }
 }
 
+/// How far a step of the tip walk may move across the line (px).
+const STEER_PX: f64 = 0.1;
+
 /// Bridges gaps: two free ends of open lines closer than twice the line
-/// width `lw` px (a gap in the ink shorter than `lw`, the ends sitting
-/// half a width back from the tips), each pointing at the other within
-/// 40°, are joined, nearest first.
+/// width `lw` px and [`BRIDGE_SLACK_PX`] (a gap in the ink shorter than
+/// `lw`, the ends sitting half a width back from the tips), each pointing
+/// at the other within 40°, are joined, nearest first.
 fn bridge(lines: Vec<Line>, lw: f64) -> Vec<Line> {
     let n = lines.len();
     let end = |e: usize| -> (Point, Vec2) {
@@ -755,7 +796,7 @@ fn bridge(lines: Vec<Line>, lw: f64) -> Vec<Line> {
             }
             let ((pa, da), (pb, db)) = (end(a), end(b));
             let d = pa.distance(pb);
-            if d >= 2.0 * lw {
+            if d >= 2.0 * lw + BRIDGE_SLACK_PX {
                 continue;
             }
             let ab = unit(pb - pa);

@@ -399,7 +399,12 @@ pub fn trace(picture: &Traceable, opts: &TraceOptions) -> Result<Output> {
             let mut doc = Document::new(w as f64, h as f64, decimals_for(opts.tolerance));
             let strokes =
                 centerline::trace_lines(&l.coverage, l.stroke_width, opts.tolerance, opts.min_area);
-            if !strokes.is_empty() {
+            if strokes.is_empty() {
+                return Err(Error::Invalid(
+                    "nothing to trace: no lines on the page (blank paper?)".into(),
+                ));
+            }
+            {
                 doc.groups.push(Group {
                     id: "layer-1".into(),
                     shapes: strokes

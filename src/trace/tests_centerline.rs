@@ -1,6 +1,7 @@
 //! Centerline tracing against drawings made from known paths: pencil-like
-//! lines (2–5 px, soft edges, grain, uneven light) with X crossings and
-//! T junctions, read through the raster reader as a photo would be.
+//! lines (2–5 px, soft edges, grain, uneven light) with X crossings, T
+//! junctions, loops and gaps, read through the raster reader as a photo
+//! would be.
 
 use super::centerline::{trace_lines, Stroke};
 use crate::read::ink::read_lines;
@@ -16,6 +17,16 @@ struct Drawn {
 fn segment(a: Point, b: Point) -> Vec<Point> {
     let n = (a.distance(b) / 0.25).ceil().max(1.0) as usize;
     (0..=n).map(|i| a.lerp(b, i as f64 / n as f64)).collect()
+}
+
+fn arc(c: Point, r: f64, from: f64, to: f64) -> Vec<Point> {
+    let n = ((to - from).abs() * r / 0.25).ceil().max(2.0) as usize;
+    (0..=n)
+        .map(|i| {
+            let t = from + (to - from) * i as f64 / n as f64;
+            Point::new(c.x + r * t.cos(), c.y + r * t.sin())
+        })
+        .collect()
 }
 
 fn dist_to(p: Point, pts: &[Point]) -> f64 {
@@ -98,6 +109,9 @@ fn hausdorff(a: &[Point], b: &[Point]) -> f64 {
 
 fn trace(lines: &[Drawn], w: usize, h: usize, seed: u64) -> Vec<Stroke> {
     let png = pencil_png(lines, w, h, seed);
+    if let Ok(dir) = std::env::var("CENTERLINE_DUMP") {
+        let _ = std::fs::write(format!("{dir}/{w}x{h}-{seed}.png"), &png);
+    }
     let ink = read_lines(&png, &ImageOptions::default(), None).expect("drawing reads");
     trace_lines(&ink.coverage, None, 0.25, 4.0)
 }
@@ -181,6 +195,72 @@ fn t_junction_ends_the_stem_on_the_bar() {
             },
         ];
         check(&format!("T {width}"), &lines, 170, 150);
+    }
+}
+
+#[test]
+fn loops_and_curves_cross_through() {
+    let width = 3.0;
+    let tau = std::f64::consts::TAU;
+    let wave: Vec<Point> = (0..=600)
+        .map(|i| {
+            let x = 15.0 + 170.0 * i as f64 / 600.0;
+            Point::new(x, 100.0 + 30.0 * (x / 25.0).sin())
+        })
+        .collect();
+    let lines = [
+        Drawn {
+            pts: arc(Point::new(70.0, 90.0), 40.0, 0.0, tau),
+            width,
+        },
+        Drawn { pts: wave, width },
+        Drawn {
+            pts: arc(Point::new(150.0, 42.0), 25.0, 0.3, 4.5),
+            width,
+        },
+    ];
+    check("loops", &lines, 200, 170);
+}
+
+/// A 4-px line from (20, 40) to (160, 60) broken by a gap of `gap` px
+/// between its inks (round ends), drawn in pencil with `seed`, traced.
+fn broken_line(gap: f64, seed: u64) -> (Vec<Point>, Vec<Stroke>) {
+    let width = 4.0;
+    let whole = segment(Point::new(20.0, 40.0), Point::new(160.0, 60.0));
+    let along = (whole[250] - whole[240]) * ((width + gap) / whole[240].distance(whole[250]));
+    let png = pencil_png(
+        &[
+            Drawn {
+                pts: segment(Point::new(20.0, 40.0), whole[240]),
+                width,
+            },
+            Drawn {
+                pts: segment(whole[240] + along, Point::new(160.0, 60.0)),
+                width,
+            },
+        ],
+        180,
+        100,
+        seed,
+    );
+    let ink = read_lines(&png, &ImageOptions::default(), None).expect("drawing reads");
+    (whole, trace_lines(&ink.coverage, None, 0.25, 4.0))
+}
+
+#[test]
+fn gaps_shorter_than_the_width_are_bridged() {
+    for seed in 1..=3 {
+        let (whole, strokes) = broken_line(2.5, seed);
+        assert_eq!(strokes.len(), 1, "seed {seed}: the 2.5-px gap is bridged");
+        assert!(hausdorff(&whole, &flatten(&strokes[0].path)) <= 1.5);
+    }
+}
+
+#[test]
+fn gaps_of_two_widths_stay_open() {
+    for seed in 1..=3 {
+        let (_, strokes) = broken_line(8.0, seed);
+        assert_eq!(strokes.len(), 2, "seed {seed}: the 8-px gap stays open");
     }
 }
 

@@ -33,7 +33,9 @@ fn style(name: &str) -> &'static BrushStyle {
     static CACHE: OnceLock<Vec<BrushStyle>> = OnceLock::new();
     let all = CACHE.get_or_init(|| {
         let opts = AnalysisOptions {
-            cache_dir: Some(std::env::temp_dir().join("flourish-test-cache")),
+            cache_dir: Some(
+                std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("target/test-cache"),
+            ),
             ..AnalysisOptions::default()
         };
         STYLES

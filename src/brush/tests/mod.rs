@@ -15,7 +15,9 @@ pub(crate) fn vine() -> &'static BrushStyle {
     static STYLE: OnceLock<BrushStyle> = OnceLock::new();
     STYLE.get_or_init(|| {
         let opts = AnalysisOptions {
-            cache_dir: Some(std::env::temp_dir().join("flourish-test-cache")),
+            cache_dir: Some(
+                std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("target/test-cache"),
+            ),
             ..AnalysisOptions::default()
         };
         let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
