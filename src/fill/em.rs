@@ -588,6 +588,13 @@ fn synthesize_levels(
             let full = params.iterations.max(n);
             let skipped = (full - n) as f32 * 0.75 / full as f32;
             let (mut lambda, mut mu) = (0.2 + skipped, 0.8 - skipped);
+            // The level set moves where an active neighbourhood's patch
+            // reaches, with a pixel to spare.
+            let live = near.as_ref().map(|d| levelset::Live {
+                near: d,
+                reach2: (r as f32 * std::f32::consts::SQRT_2 + 1.0 + patch_reach(r) as f32 + 1.0)
+                    .powi(2),
+            });
             for it in 0..n {
                 let target = channels_of(&st.phi, &st.colour, params.alpha, clamp);
                 let reach = (r as f32 * std::f32::consts::SQRT_2 + 1.0).powi(2);
@@ -643,7 +650,7 @@ fn synthesize_levels(
                     band: r as f32 + 2.0,
                 };
                 for (phi, (mean, count)) in st.phi.iter_mut().zip(&votes.sdf) {
-                    levelset::evolve(phi, mean, count, &ev);
+                    levelset::evolve(phi, mean, count, &ev, live);
                 }
 
                 st.colour = votes.colour;
@@ -939,6 +946,9 @@ fn vote(pb: &Problem, nnf: &Nnf, lv: &Level, hist: &[[f32; 2]], w: usize, h: usi
     let per_centre: Vec<(f32, usize)> = (0..nnf.matches.len())
         .into_par_iter()
         .map(|k| {
+            if !pb.is_active(k) {
+                return (0.0, 0);
+            }
             let (qx, qy) = nnf.centre(k);
             let m = nnf.matches[k];
             (

@@ -463,6 +463,14 @@ pub fn in_region(
 /// across the rows by spacing/pitch, where the CVT is isotropic, and the
 /// seeds are stretched back — an anisotropic CVT with the row's spacing
 /// along x and its pitch along y.
+///
+/// The count starts from the area (Barla et al. §3.2, N_ref·A_tar/A_ref).
+/// Where a field's region is narrower than a few spacings (the bars of a
+/// letter, a ring) that count spreads the seeds along the shape farther
+/// apart than the example's elements, so while the seeds' mean
+/// nearest-neighbour distance is over [`SPARSE`] times the example's, the
+/// count is raised by that ratio (the spacing of seeds in a band falls as
+/// one over their count) and the seeds placed again, a few times at most.
 fn fill(
     style: &PatternStyle,
     region: &Region,
@@ -473,36 +481,49 @@ fn fill(
     let r = &style.reference;
     let expected = style.expected_in_area(region.area);
     too_many(expected, opts.max_elements)?;
-    let n = (expected.round() as usize).max(1);
+    let mut n = (expected.round() as usize).max(1);
     let squeeze = r.dist.spacing / r.dist.pitch;
-    let mut points: Vec<Point> = if (squeeze - 1.0).abs() < 1e-9 {
-        seeds::lloyd(
-            region,
-            n,
-            crate::rng::hash(key),
-            style.params.lloyd_iterations,
-        )
-        .points
+    let field = (squeeze - 1.0).abs() < 1e-9;
+    let squeezed = if field {
+        None
     } else {
-        let squeezed = Region::new(
+        Some(Region::new(
             &(Affine::scale_non_uniform(1.0, squeeze) * outline.clone()),
             region.rule,
             0.05,
-        )?;
-        seeds::lloyd(
-            &squeezed,
+        )?)
+    };
+    let place_seeds = |n: usize| {
+        let mut points = seeds::lloyd(
+            squeezed.as_ref().unwrap_or(region),
             n,
             crate::rng::hash(key),
             style.params.lloyd_iterations,
         )
-        .points
+        .points;
+        for p in &mut points {
+            p.y /= squeeze;
+        }
+        // Squeezing back can land a seed outside only through the two
+        // flattenings' difference (≤ 0.1 units); such a seed is dropped whole.
+        points.retain(|&p| region.contains(p));
+        points
     };
-    for p in &mut points {
-        p.y /= squeeze;
+    let mut points = place_seeds(n);
+    let own = distribution::nearest_spacing(&r.dist.centres);
+    if let (true, Dim::Two, Some(own)) = (field, r.dist.dim, own) {
+        for _ in 0..4 {
+            let Some(m) = mean_nearest(&points) else {
+                break;
+            };
+            let more = (n as f64 * m / own).ceil();
+            if m <= SPARSE * own || more > opts.max_elements as f64 {
+                break;
+            }
+            n = more as usize;
+            points = place_seeds(n);
+        }
     }
-    // Squeezing back can land a seed outside only through the two
-    // flattenings' difference (≤ 0.1 units); such a seed is dropped whole.
-    points.retain(|&p| region.contains(p));
     let squeezed_pts: Vec<Point> = points
         .iter()
         .map(|p| Point::new(p.x, p.y * squeeze))
@@ -523,6 +544,36 @@ fn fill(
         key,
         &|p| region.contains(p),
     ))
+}
+
+/// How much farther apart than the example's elements (mean nearest
+/// neighbour distance, ratio) a field's seeds may be before their count
+/// is raised.
+const SPARSE: f64 = 1.1;
+
+/// Mean distance from each point to its nearest other point, taken among
+/// its Delaunay neighbours (the nearest is one of them); `None` for fewer
+/// than two points.
+fn mean_nearest(pts: &[Point]) -> Option<f64> {
+    if pts.len() < 2 {
+        return None;
+    }
+    if pts.len() < 4 {
+        return distribution::nearest_spacing(pts);
+    }
+    let g = Graph::delaunay(pts);
+    let sum: f64 = g
+        .adj
+        .iter()
+        .enumerate()
+        .map(|(i, a)| {
+            a.iter()
+                .map(|&j| pts[i].distance(pts[j]))
+                .fold(f64::INFINITY, f64::min)
+        })
+        .filter(|d| d.is_finite())
+        .sum();
+    Some(sum / pts.len() as f64)
 }
 
 /// The rigid transform putting reference element `p.element`'s centre at
