@@ -154,6 +154,12 @@ pub fn step(
     }
 }
 
+/// [`reinitialize_in`] over the whole grid.
+#[cfg(test)]
+pub fn reinitialize(phi: &mut Grid<f32>) {
+    reinitialize_in(phi, None);
+}
+
 /// Replaces `phi` by the signed distance to its zero level (pixel units,
 /// negative inside): sub-pixel contours of `Φ`, exact distances to them
 /// within `sdf::BAND`, within half a pixel beyond, except where the
@@ -162,14 +168,11 @@ pub fn step(
 /// the distance to the nearest pixel of the other side, which can be
 /// larger. A field without a zero level keeps its sign, clamped to the
 /// grid's diagonal.
-#[cfg(test)]
-pub fn reinitialize(phi: &mut Grid<f32>) {
-    reinitialize_in(phi, None);
-}
-
-/// [`reinitialize`], exact only where `live` asks ([`Live::exact`]): the
-/// zero level's segments outside that zone are left out, so the pixels
-/// beyond it keep their sign and get the distance to the other side.
+///
+/// Exact only where `live` asks ([`Live::exact`]; everywhere for `None`):
+/// the zero level's segments outside that zone are left out, so the
+/// pixels beyond it keep their sign and get the distance to the other
+/// side.
 pub fn reinitialize_in(phi: &mut Grid<f32>, live: Option<Live>) {
     let (w, h) = (phi.width(), phi.height());
     let mut segments = Vec::new();
