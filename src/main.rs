@@ -1007,7 +1007,7 @@ impl Ticker {
                 if stop.load(Ordering::Relaxed) {
                     return;
                 }
-                std::thread::park_timeout(tick.min(after - start.elapsed()));
+                std::thread::park_timeout(tick.min(after.saturating_sub(start.elapsed())));
             }
             let terminal = std::io::stderr().is_terminal();
             let spinner = terminal.then(|| {
