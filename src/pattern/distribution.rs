@@ -280,6 +280,20 @@ impl Distribution {
     }
 }
 
+impl Distribution {
+    /// Distance between neighbours when the elements are laid in a chain
+    /// along a path, reference units: a row keeps its own spacing; a field's
+    /// chain takes the field's mean nearest-neighbour distance, so that each
+    /// element meets its nearest neighbour as close as in the example (the
+    /// Delaunay edges of a field are longer than its nearest neighbours).
+    pub fn chain_spacing(&self) -> f64 {
+        match self.dim {
+            Dim::One => self.spacing,
+            Dim::Two => nearest_spacing(&self.centres).unwrap_or(self.spacing),
+        }
+    }
+}
+
 /// True when neighbours at `offsets` surround their element: in 1-D one
 /// on each side, in 2-D no angular gap between them wider than 0.8π.
 pub fn surrounded(offsets: impl Iterator<Item = Vec2>, dim: Dim) -> bool {

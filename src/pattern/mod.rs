@@ -378,8 +378,10 @@ fn too_many(n: f64, limit: usize) -> std::result::Result<(), String> {
 /// width.
 ///
 /// When the band holds fewer than 1.5 rows of elements (rows = width /
-/// pitch; 2 rows for a row example), it is 1-D: seeds in a chain at the example's spacing, elements
-/// turned with the path, variation never moving a centre more than width/2
+/// pitch; 2 rows for a row example), it is 1-D: seeds in a chain at the
+/// example's [chain spacing](Distribution::chain_spacing) (those that would
+/// come closer than [`CROWDED`] spacings to another where the path turns
+/// back on itself are left out), elements turned with the path, variation never moving a centre more than width/2
 /// off the path. A wider band is filled in 2-D in path coordinates (arc
 /// length, offset): the band is straightened into a length × width
 /// rectangle, synthesized like a region and bent back along the path.
@@ -391,7 +393,7 @@ pub fn along_path(
     key: &[u64],
 ) -> std::result::Result<Vec<PlacedElement>, String> {
     let r = &style.reference;
-    let spacing = r.dist.spacing;
+    let spacing = r.dist.chain_spacing();
     let lines = Polyline::from_path(spine, 0.05);
     // A row example is meant as a row: it stacks only when two fit.
     let rows = width / r.dist.pitch;
@@ -419,7 +421,8 @@ pub fn along_path(
             let region = Region::new(&rect, crate::svg_out::FillRule::NonZero, 0.05)?;
             fill(style, &region, &rect, opts, &k)?
         } else {
-            let s = seeds::seeds_along(line, spacing);
+            let s =
+                seeds::thin_crowded(line, &seeds::seeds_along(line, spacing), CROWDED * spacing);
             let closed = line.closed;
             let target = Target {
                 pos: s.iter().map(|&x| Point::new(x, 0.0)).collect(),
@@ -545,6 +548,11 @@ fn fill(
         &|p| region.contains(p),
     ))
 }
+
+/// The least distance, as a fraction of the chain spacing, between two
+/// elements of one chain anywhere in the plane: the gallery's spacing
+/// tolerance (within 20 % of the example's).
+const CROWDED: f64 = 0.8;
 
 /// How much farther apart than the example's elements (mean nearest
 /// neighbour distance, ratio) a field's seeds may be before their count

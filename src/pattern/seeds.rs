@@ -660,6 +660,41 @@ pub fn seeds_along(line: &Polyline, spacing: f64) -> Vec<f64> {
     (0..n).map(|i| (i as f64 + 0.5) * l / n as f64).collect()
 }
 
+/// Drops the 1-D seeds (arc lengths along `line`, in order) that would sit
+/// closer than `min_gap` units, in the plane, to a seed kept before them:
+/// where a path turns back on itself (a tight spiral, a hairpin) the
+/// elements of neighbouring turns would otherwise crowd or overlap, while
+/// the example's elements keep their spacing in every direction. Seeds are
+/// looked up in a grid of `min_gap` cells, so the cost is linear.
+pub fn thin_crowded(line: &Polyline, seeds: &[f64], min_gap: f64) -> Vec<f64> {
+    if min_gap.is_nan() || min_gap <= 0.0 {
+        return seeds.to_vec();
+    }
+    let cell = |p: Point| {
+        (
+            (p.x / min_gap).floor() as i64,
+            (p.y / min_gap).floor() as i64,
+        )
+    };
+    let mut grid: std::collections::HashMap<(i64, i64), Vec<Point>> = Default::default();
+    let mut kept = Vec::with_capacity(seeds.len());
+    for &s in seeds {
+        let p = line.at(s);
+        let (cx, cy) = cell(p);
+        let crowded = (cx - 1..=cx + 1).any(|x| {
+            (cy - 1..=cy + 1).any(|y| {
+                grid.get(&(x, y))
+                    .is_some_and(|v| v.iter().any(|q| q.distance(p) < min_gap))
+            })
+        });
+        if !crowded {
+            grid.entry((cx, cy)).or_default().push(p);
+            kept.push(s);
+        }
+    }
+    kept
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -787,5 +822,38 @@ mod tests {
             .map(|(c, &z)| r.moments_in(c, z).area)
             .sum();
         assert!((total - 10_000.0).abs() < 1e-6, "{total}");
+    }
+
+    #[test]
+    fn seeds_on_a_hairpin_keep_their_distance_in_the_plane() {
+        // Two legs 12 units apart, joined by a half turn; seeds 20 apart
+        // along the path would face each other across the gap.
+        let mut p = BezPath::new();
+        p.move_to((0.0, 0.0));
+        p.line_to((200.0, 0.0));
+        p.line_to((200.0, 12.0));
+        p.line_to((0.0, 12.0));
+        let line = &Polyline::from_path(&p, 0.05)[0];
+        let all = seeds_along(line, 20.0);
+        let kept = thin_crowded(line, &all, 16.0);
+        assert!(kept.len() < all.len() && kept.len() >= all.len() / 2);
+        // Brute force: every kept pair is far enough apart, and every
+        // dropped seed is too close to one kept before it.
+        let at = |s: f64| line.at(s);
+        for (i, &a) in kept.iter().enumerate() {
+            for &b in &kept[i + 1..] {
+                assert!(at(a).distance(at(b)) >= 16.0, "{a} {b}");
+            }
+        }
+        for &s in all.iter().filter(|s| !kept.contains(s)) {
+            assert!(kept.iter().any(|&k| k < s && at(k).distance(at(s)) < 16.0));
+        }
+        // A straight run loses nothing.
+        let mut q = BezPath::new();
+        q.move_to((0.0, 0.0));
+        q.line_to((200.0, 0.0));
+        let straight = &Polyline::from_path(&q, 0.05)[0];
+        let s = seeds_along(straight, 20.0);
+        assert_eq!(thin_crowded(straight, &s, 16.0), s);
     }
 }

@@ -467,7 +467,7 @@ fn count_along_a_path_follows_the_example_spacing() {
         panic!("wave is a path")
     };
     let len = spine.perimeter(0.01);
-    let spacing = out.queries[0].style.reference.dist.spacing;
+    let spacing = out.queries[0].style.reference.dist.chain_spacing();
     assert_eq!(
         out.queries[0].elements.len(),
         (len / spacing).round() as usize
