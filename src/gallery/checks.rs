@@ -12,7 +12,9 @@
 //!   the pattern (a motif's shape, not the paper round it). Gap regularity
 //!   is left out for a region too narrow to hold a whole gap.
 //! - pattern (stroke-pattern-synthesis.txt §3): elements placed, their
-//!   nearest-neighbour spacing within 20 % of the example's.
+//!   nearest-neighbour spacing within 20 % of the example's, no element's
+//!   ink over another's (`overlap`: the share of ink drawn twice, each
+//!   element rendered on its own at 4 px per unit).
 //! - brush (decobrush.txt §5–7): ink covers 95 % of the path within half
 //!   a width, none beyond 1.5 widths, no piece smaller than the exemplars'
 //!   smallest drawn element, structure density within 30 % of the
@@ -592,8 +594,10 @@ fn pattern(style: &Path, input: &Path) -> Outcome {
     let svg = out.to_document().to_svg();
     let own = mean_nearest(&ps.reference.dist.centres).unwrap_or(0.0);
     let mut spacing = Vec::new();
+    let mut overlap = Vec::new();
     let mut placed = f64::INFINITY;
     for q in &out.queries {
+        overlap.push(overlapping_ink(q)?);
         let centres: Vec<kurbo::Point> = q.elements.iter().map(|e| e.centre).collect();
         placed = placed.min(centres.len() as f64);
         if let Some(m) = mean_nearest(&centres) {
@@ -605,8 +609,78 @@ fn pattern(style: &Path, input: &Path) -> Outcome {
         vec![
             Check::at_least("placed", placed, 2.0),
             Check::at_most("spacing", worst(spacing.into_iter(), false, 0.0), 0.2),
+            Check::at_most("overlap", worst(overlap.into_iter(), false, 0.0), 0.0),
         ],
     ))
+}
+
+/// Pixels per user unit at which [`overlapping_ink`] renders elements.
+const OVERLAP_PX: f64 = 4.0;
+
+/// The share of a query's ink drawn by two elements or more: each placed
+/// element rendered on its own at [`OVERLAP_PX`] px per unit, a pixel
+/// inked where its coverage is over a half, and the pixels inked by two
+/// elements counted against all inked pixels. Touching elements share
+/// no pixel over half covered by both; any real overlap wider than a
+/// quarter unit does.
+fn overlapping_ink(q: &crate::pattern::QueryPattern) -> crate::Result<f64> {
+    use crate::svg_out::{Document, Group};
+    let mut count: std::collections::HashMap<(i64, i64), u8> = Default::default();
+    for e in &q.elements {
+        let shapes: Vec<_> = q
+            .style
+            .element_shapes(e.element)
+            .map(|s| {
+                let mut s = s.clone();
+                s.path.apply_affine(e.transform);
+                s
+            })
+            .collect();
+        let Some(bbox) = shapes
+            .iter()
+            .map(|s| {
+                let grow = s.stroke.as_ref().map_or(0.0, |k| k.width) + 1.0;
+                kurbo::Shape::bounding_box(&s.path).inflate(grow, grow)
+            })
+            .reduce(|a, b| a.union(b))
+        else {
+            continue;
+        };
+        // Snapped to the pixel grid, so that all elements share it.
+        let (x0, y0) = (
+            (bbox.x0 * OVERLAP_PX).floor(),
+            (bbox.y0 * OVERLAP_PX).floor(),
+        );
+        let (x1, y1) = ((bbox.x1 * OVERLAP_PX).ceil(), (bbox.y1 * OVERLAP_PX).ceil());
+        let mut doc = Document::new(x1 - x0, y1 - y0, 4);
+        doc.view_box = kurbo::Rect::new(
+            x0 / OVERLAP_PX,
+            y0 / OVERLAP_PX,
+            x1 / OVERLAP_PX,
+            y1 / OVERLAP_PX,
+        );
+        doc.groups.push(Group {
+            id: "e".into(),
+            shapes,
+        });
+        let tree = crate::read::svg::parse_svg(doc.to_svg().as_bytes())?;
+        let pix = crate::render::render_tree(&tree, None, None)?;
+        let w = pix.width() as usize;
+        for (i, px) in pix.pixels().iter().enumerate() {
+            if px.alpha() > 127 {
+                let at = (x0 as i64 + (i % w) as i64, y0 as i64 + (i / w) as i64);
+                let c = count.entry(at).or_default();
+                *c = c.saturating_add(1);
+            }
+        }
+    }
+    let inked = count.len();
+    let twice = count.values().filter(|&&c| c > 1).count();
+    Ok(if inked == 0 {
+        0.0
+    } else {
+        twice as f64 / inked as f64
+    })
 }
 
 fn brush(style: &Path, input: &Path) -> Outcome {
@@ -861,4 +935,35 @@ fn trace(input: &Path) -> Outcome {
         checks.push(Check::at_least("cutout-iou", worst, 0.0));
     }
     Ok((svg, checks))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pattern::{PatternStyle, PlacedElement, QueryPattern};
+    use kurbo::Affine;
+
+    /// Two copies of one element: none of the ink is shared when they
+    /// stand apart, all of it when they stand on each other, part of it
+    /// when they half overlap.
+    #[test]
+    fn overlap_counts_ink_drawn_twice() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("styles/flowers");
+        let style = std::sync::Arc::new(PatternStyle::load(&dir).unwrap());
+        let size = kurbo::Shape::bounding_box(&style.element_shapes(0).next().unwrap().path);
+        let at = |dx: f64| PlacedElement {
+            element: 0,
+            transform: Affine::translate((dx, 0.0)),
+            centre: kurbo::Point::new(dx, 0.0),
+        };
+        let pair = |dx: f64| QueryPattern {
+            id: "q-1".into(),
+            style: style.clone(),
+            elements: vec![at(0.0), at(dx)],
+        };
+        assert_eq!(overlapping_ink(&pair(3.0 * size.width())).unwrap(), 0.0);
+        assert!((overlapping_ink(&pair(0.0)).unwrap() - 1.0).abs() < 1e-9);
+        let half = overlapping_ink(&pair(0.5 * size.width())).unwrap();
+        assert!(half > 0.05 && half < 0.6, "{half}");
+    }
 }
