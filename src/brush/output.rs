@@ -351,7 +351,7 @@ fn read_layers(
     jac: &Jacobians,
     sub: usize,
     reach: &Reach,
-) -> Vec<Grid<f32>> {
+) -> Vec<Grid<i16>> {
     let palette = &style.facts.palette;
     let g = &field.coords;
     let (w, h) = (g.width(), g.height());
@@ -402,9 +402,9 @@ fn read_layers(
             }
         })
         .collect();
-    let mut grids: Vec<Vec<f32>> = (0..n).map(|_| vec![paper; ow * oh]).collect();
+    let mut grids: Vec<Vec<i16>> = (0..n).map(|_| vec![pack(paper); ow * oh]).collect();
     // Row `oy` of every layer, to be written by one task.
-    let mut rows: Vec<Vec<&mut [f32]>> = (0..oh).map(|_| Vec::with_capacity(n)).collect();
+    let mut rows: Vec<Vec<&mut [i16]>> = (0..oh).map(|_| Vec::with_capacity(n)).collect();
     for grid in &mut grids {
         for (row, chunk) in rows.iter_mut().zip(grid.chunks_mut(ow.max(1))) {
             row.push(chunk);
@@ -488,19 +488,46 @@ fn read_layers(
             let ink = read(None).max(cut);
             if ink >= FAR {
                 for row in out.iter_mut() {
-                    row[ox] = ink;
+                    row[ox] = pack(ink);
                 }
                 continue;
             }
             for (l, row) in out.iter_mut().enumerate() {
-                row[ox] = read(Some(l)).max(cut);
+                row[ox] = pack(read(Some(l)).max(cut));
             }
         }
     });
     grids
         .into_iter()
-        .map(|data| Grid::from_vec(ow, oh, data).unwrap_or_else(|| Grid::new(ow, oh, paper)))
+        .map(|data| Grid::from_vec(ow, oh, data).unwrap_or_else(|| Grid::new(ow, oh, pack(paper))))
         .collect()
+}
+
+/// Output px per unit of a layer distance as [`read_layers`] holds it:
+/// each layer of a query's output grid is kept in 16 bits (distances to
+/// ±128 px in steps of 1/256 px, far below the tracing tolerance), half
+/// the memory of 32-bit floats, and widened one layer at a time for
+/// tracing.
+const LAYER_STEP: f32 = 1.0 / 256.0;
+
+/// A layer distance (output px) in [`LAYER_STEP`]s, clamped to 16 bits,
+/// with its sign kept: ink (below zero) stays ink however close to the
+/// outline, so the ink mask, and what is measured on it, is the same as
+/// the unrounded layer's.
+fn pack(v: f32) -> i16 {
+    let q = (v / LAYER_STEP)
+        .round()
+        .clamp(f32::from(i16::MIN), f32::from(i16::MAX)) as i16;
+    if v < 0.0 {
+        q.min(-1)
+    } else {
+        q.max(0)
+    }
+}
+
+/// A layer's distances in output px.
+fn unpack(g: &Grid<i16>) -> Grid<f32> {
+    g.map(|v| f32::from(v) * LAYER_STEP)
 }
 
 /// The final per-layer SDFs of a query on its output grid (see
@@ -508,6 +535,9 @@ fn read_layers(
 #[cfg(test)]
 pub fn final_layers(style: &BrushStyle, r: &QueryResult) -> Vec<(Color, Grid<f32>)> {
     final_layers_with(style, r, r.field.clone())
+        .into_iter()
+        .map(|(c, g)| (c, unpack(&g)))
+        .collect()
 }
 
 /// Output px per finest exemplar px of a query's output grid.
@@ -546,7 +576,7 @@ pub fn debris_area(style: &BrushStyle) -> f64 {
 /// style, not a constant) are synthesis debris and are cleared; the
 /// query's largest piece is its body and always stays. `field` is the
 /// query's field (or a copy of it), used up.
-fn final_layers_with(style: &BrushStyle, r: &QueryResult, field: Field) -> Vec<(Color, Grid<f32>)> {
+fn final_layers_with(style: &BrushStyle, r: &QueryResult, field: Field) -> Vec<(Color, Grid<i16>)> {
     let rings = border_rings(r);
     let reach = Reach::of(&field.coords, rings);
     let field = extend_owned(style, field, rings);
@@ -554,13 +584,13 @@ fn final_layers_with(style: &BrushStyle, r: &QueryResult, field: Field) -> Vec<(
     let read = read_layers(style, &field, &jac, r.sub, &reach);
     drop(reach);
     drop(jac);
-    let mut layers: Vec<(Color, Grid<f32>)> =
+    let mut layers: Vec<(Color, Grid<i16>)> =
         style.facts.palette.iter().copied().zip(read).collect();
     let Some((_, first)) = layers.first() else {
         return layers;
     };
     let (w, h) = (first.width(), first.height());
-    let ink = Grid::from_fn(w, h, |x, y| layers.iter().any(|(_, g)| g.get(x, y) < 0.0));
+    let ink = Grid::from_fn(w, h, |x, y| layers.iter().any(|(_, g)| g.get(x, y) < 0));
     let comps = components(&ink);
     // A query shorter than every exemplar can have a body smaller than
     // the exemplars' smallest piece: the largest piece always stays.
@@ -575,7 +605,7 @@ fn final_layers_with(style: &BrushStyle, r: &QueryResult, field: Field) -> Vec<(
         for (_, g) in &mut layers {
             for &i in &comp {
                 if let Some(v) = g.data_mut().get_mut(i) {
-                    *v = v.max(0.5);
+                    *v = (*v).max(pack(0.5));
                 }
             }
         }
@@ -599,8 +629,12 @@ fn trace_field(
 ) -> Group {
     let to_user = r.out_canvas().to_user();
     let mut shapes = Vec::new();
-    for (color, dist) in final_layers_with(style, r, field) {
-        let sdf = Sdf { dist, to_user };
+    for (color, layer) in final_layers_with(style, r, field) {
+        let sdf = Sdf {
+            dist: unpack(&layer),
+            to_user,
+        };
+        drop(layer);
         for p in trace_sdf(&sdf, opts) {
             shapes.push(Shape {
                 fill_rule: FillRule::NonZero,

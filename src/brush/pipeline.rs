@@ -251,8 +251,9 @@ pub fn query_share() -> u64 {
     crate::memory::budget() / 2
 }
 
-/// Largest output grid of one brush query, pixels in all (32 Mpx, about
-/// 30 bytes each: the layers' SDFs and the ink mask); a finer one is not
+/// Largest output grid of one brush query, pixels in all (32 Mpx, 2 bytes
+/// per layer each for the layers' SDFs, plus the ink mask and the layer
+/// being traced); a finer one is not
 /// allocated, the subdivision is lowered instead.
 pub const MAX_OUT_PIXELS: u64 = 32 << 20;
 
