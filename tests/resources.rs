@@ -606,3 +606,103 @@ fn a_long_thin_stroke_is_brushed_in_pieces_within_the_budget() {
     assert!(b.left() < 20.0 && b.right() > 780.0, "{b:?}");
     assert!(b.top() < 20.0 && b.bottom() > 580.0, "{b:?}");
 }
+
+/// Runs flourish with `args` and returns its exit code, stderr and peak
+/// resident memory in MiB (the kernel's high-water mark, read while it
+/// runs: the last reading before it ends, at most the true peak).
+fn peak_resident(args: &[&str]) -> (Option<i32>, String, u64) {
+    let mut child = flourish()
+        .args(args)
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("flourish runs");
+    let status = format!("/proc/{}/status", child.id());
+    let mut kib = 0u64;
+    while child.try_wait().expect("wait").is_none() {
+        if let Ok(s) = std::fs::read_to_string(&status) {
+            if let Some(v) = s
+                .lines()
+                .find_map(|l| l.strip_prefix("VmHWM:"))
+                .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<u64>().ok())
+            {
+                kib = kib.max(v);
+            }
+        }
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    let out = child.wait_with_output().expect("output");
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+        kib / 1024,
+    )
+}
+
+/// Issue 23: a stroke 500 widths long (10 000 units at 20 wide, in 13 rows
+/// across an 800-unit page) is brushed within the 400 MB memory goal, as
+/// the program counts its heap and as the kernel counts its pages.
+#[test]
+fn a_stroke_five_hundred_widths_long_stays_within_the_memory_goal() {
+    let dir = folder("five-hundred-widths");
+    let mut d = String::new();
+    let (mut y, mut len, mut last) = (40.0f64, 0.0f64, None::<(f64, f64)>);
+    for row in 0.. {
+        for i in 0..=76 {
+            let x = if row % 2 == 0 {
+                20 + 10 * i
+            } else {
+                780 - 10 * i
+            } as f64;
+            let p = (x, y + 12.0 * (x / 40.0).sin());
+            if let Some(q) = last {
+                len += ((p.0 - q.0).powi(2) + (p.1 - q.1).powi(2)).sqrt();
+            }
+            d += &format!(
+                "{}{:.1} {:.1} ",
+                if last.is_none() { "M" } else { "L" },
+                p.0,
+                p.1
+            );
+            last = Some(p);
+        }
+        y += 100.0;
+        if len >= 10_000.0 {
+            break;
+        }
+    }
+    let sketch = dir.join("long.svg");
+    std::fs::write(
+        &sketch,
+        format!(r##"<svg xmlns="http://www.w3.org/2000/svg" width="800" height="{h}" viewBox="0 0 800 {h}"><path d="{d}" fill="none" stroke="#000" stroke-width="20"/></svg>"##, h = y + 40.0),
+    )
+    .expect("a sketch");
+    let out = dir.join("out.svg");
+    let (code, err, mib) = peak_resident(&[
+        "-v",
+        "brush",
+        "--style",
+        "vine",
+        sketch.to_str().expect("utf-8"),
+        "-o",
+        out.to_str().expect("utf-8"),
+    ]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(mib <= 400, "peak resident {mib} MiB");
+    let counted = err
+        .lines()
+        .find_map(|l| l.strip_prefix("flourish: peak memory "))
+        .and_then(|l| {
+            let mut w = l.split(' ');
+            let n = w.next()?.parse::<f64>().ok()?;
+            match w.next()? {
+                "KB" => Some(n / 1024.0),
+                "MB" => Some(n),
+                "GB" => Some(n * 1024.0),
+                _ => None,
+            }
+        })
+        .expect("-v reports the peak");
+    assert!(counted <= 400.0, "{err}");
+}
