@@ -649,9 +649,13 @@ fn synthesize_levels(
                     steps: params.steps,
                     band: r as f32 + 2.0,
                 };
-                for (phi, (mean, count)) in st.phi.iter_mut().zip(&votes.sdf) {
-                    levelset::evolve(phi, mean, count, &ev, live);
-                }
+                // Layers evolve independently: one task each.
+                st.phi
+                    .par_iter_mut()
+                    .zip(&votes.sdf)
+                    .for_each(|(phi, (mean, count))| {
+                        levelset::evolve(phi, mean, count, &ev, live);
+                    });
 
                 st.colour = votes.colour;
                 lambda += 0.75 / full as f32;

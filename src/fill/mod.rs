@@ -53,6 +53,7 @@ use crate::svg_out::{decimals_for, Color, Document, FillRule, Group, Shape};
 use crate::trace::{trace_sdf, TraceOptions};
 use em::EmParams;
 use kurbo::{BezPath, PathEl, Point, Shape as _};
+use rayon::prelude::*;
 use region::Region;
 use std::path::Path;
 use tile::{Palette, SourceDirection, Swatch, Tile};
@@ -520,8 +521,9 @@ pub fn fill_sketch<'s>(
             tolerance: opts.tolerance,
             min_area: 2.0,
         };
+        // Layers trace independently, one task each, in layer order.
         let paths = layers
-            .iter()
+            .par_iter()
             .map(|l| {
                 trace_sdf(
                     &Sdf {
