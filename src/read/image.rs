@@ -485,14 +485,12 @@ impl InkScale {
 
     /// The scale of raw coverage values in 0..=1 (binned by 1/255).
     fn of_values(raw: &[f32]) -> InkScale {
-        let bin =
-            |c: f32| (crate::raster::round_positive(c.clamp(0.0, 1.0) * 255.0) as usize).min(255);
         let (counts, top) = raw
             .par_chunks(1 << 16)
             .map(|chunk| {
                 let (mut counts, mut top) = ([0u64; 256], [0f32; 256]);
                 for &c in chunk {
-                    let b = bin(c);
+                    let b = coverage_bin(c);
                     counts[b] += 1;
                     top[b] = top[b].max(c);
                 }
@@ -525,6 +523,21 @@ impl InkScale {
             return 0.0;
         }
         ((c - self.paper) / (self.ink - self.paper)).clamp(0.0, 1.0)
+    }
+}
+
+/// The bin (0..=255) of raw coverage `c` for [`InkScale::of_values`]:
+/// `c` held to 0..=1, times 255, rounded half up as
+/// [`crate::raster::round_positive`] rounds. Adding the half is exact from
+/// 0.5 up (a product under 256 has bits of fraction to spare); below it,
+/// where the float just under 0.5 would round up to 1, the bin is 0. The
+/// cast saturates.
+fn coverage_bin(c: f32) -> usize {
+    let x = c.clamp(0.0, 1.0) * 255.0;
+    if x < 0.5 {
+        0
+    } else {
+        ((x + 0.5) as usize).min(255)
     }
 }
 
@@ -998,6 +1011,41 @@ fn quantized_layers(
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    /// The bin is `round_positive` of 255 × the clamped value, at every
+    /// half-way point between bins and one and two ulps either side, at
+    /// the float just under 0.5 / 255, and out of range.
+    #[test]
+    fn coverage_bins_round_as_round_positive() {
+        let want =
+            |c: f32| (crate::raster::round_positive(c.clamp(0.0, 1.0) * 255.0) as usize).min(255);
+        let mut values = vec![
+            -1.0f32,
+            -0.0,
+            0.0,
+            1.0,
+            1.5,
+            f32::MIN_POSITIVE,
+            0.49999997 / 255.0,
+        ];
+        for k in 0..=256u32 {
+            for c in [(k as f32 + 0.5) / 255.0, k as f32 / 255.0] {
+                let b = c.to_bits();
+                values.extend([b - 2, b - 1, b, b + 1, b + 2].map(f32::from_bits));
+            }
+        }
+        for c in values {
+            assert_eq!(coverage_bin(c), want(c), "{c:e}");
+        }
+    }
+
+    proptest! {
+        #[test]
+        fn coverage_bins_match_round_positive_anywhere(c in -0.5f32..1.5) {
+            let want = (crate::raster::round_positive(c.clamp(0.0, 1.0) * 255.0) as usize).min(255);
+            prop_assert_eq!(coverage_bin(c), want);
+        }
+    }
 
     /// An opaque pixel's colour and key read off its bytes are the
     /// composite's, for every level of each channel.
