@@ -213,13 +213,18 @@ pub(super) fn pixel_coverage(
     opts: &ImageOptions,
 ) -> RasterCoverage {
     let has_alpha = px.iter().any(|p| p[3] < 255);
-    if opts.layers {
-        RasterCoverage::Layers {
-            w,
-            h,
-            layers: quantized_layers(px, w, h, has_alpha, opts.invert, false),
-        }
+    let layers = if opts.layers {
+        quantized_layers(px, w, h, has_alpha, opts.invert, false)
     } else {
+        Vec::new()
+    };
+    if !layers.is_empty() {
+        RasterCoverage::Layers { w, h, layers }
+    } else {
+        // One layer: without `--layers`, or with it when no colour but the
+        // paper fills patches of its own (a drawing in thin anti-aliased
+        // lines, every ink pixel of which borders paper or a lighter edge
+        // pixel): the drawing is its one ink, read as without `--layers`.
         // Raw coverage (alpha, or darkness on an opaque image), then put on
         // the scale of the image's own paper and ink.
         let raw: Vec<f32> = px
@@ -1011,6 +1016,46 @@ fn quantized_layers(
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    /// A drawing in one colour of thin anti-aliased lines has no palette
+    /// colour but the paper (no ink pixel has four neighbours of its own
+    /// colour): with `--layers` it is still traced, as one layer, the
+    /// coverage it has without `--layers`.
+    #[test]
+    fn layers_of_a_thin_line_drawing_are_its_one_ink() {
+        let (w, h) = (64usize, 48usize);
+        // A 1.2-px line from (4, 6) to (60, 40), anti-aliased by its
+        // distance, in dark blue on white.
+        let (a, b) = (kurbo::Point::new(4.0, 6.0), kurbo::Point::new(60.0, 40.0));
+        let px: Vec<[u8; 4]> = (0..w * h)
+            .map(|i| {
+                let p = kurbo::Point::new((i % w) as f64 + 0.5, (i / w) as f64 + 0.5);
+                let d = crate::raster::sdf::point_segment_distance(p, kurbo::Line::new(a, b));
+                let c = (0.6 - d + 0.5).clamp(0.0, 1.0);
+                let mix = |ink: f64| (255.0 * (1.0 - c) + ink * c).round() as u8;
+                [mix(20.0), mix(30.0), mix(90.0), 255]
+            })
+            .collect();
+        let plain = pixel_coverage(&px, w, h, &ImageOptions::default());
+        let layered = pixel_coverage(
+            &px,
+            w,
+            h,
+            &ImageOptions {
+                layers: true,
+                ..ImageOptions::default()
+            },
+        );
+        let one = |r: &RasterCoverage| match r {
+            RasterCoverage::Layers { layers, .. } if layers.len() == 1 => {
+                Some((layers[0].0, layers[0].1.data().to_vec()))
+            }
+            _ => None,
+        };
+        let (colour, cov) = one(&plain).expect("one anti-aliased layer");
+        assert!(cov.iter().filter(|&&c| c >= 0.5).count() > 40);
+        assert_eq!(one(&layered), Some((colour, cov)));
+    }
 
     /// The bin is `round_positive` of 255 × the clamped value, at every
     /// half-way point between bins and one and two ulps either side, at
