@@ -190,16 +190,15 @@ pub(super) fn pixel_partition(
 }
 
 /// `rgb` as a grey image when every pixel's three channels are equal,
-/// else `None` (found at the first coloured pixel).
+/// else `None` (found at the first coloured pixel). Checked in one pass
+/// and copied in another, which knows its length (no growth check per
+/// pixel).
 fn grey_of_rgb(rgb: &image::RgbImage) -> Option<image::GrayImage> {
     let raw = rgb.as_raw();
-    let mut grey = Vec::with_capacity(raw.len() / 3);
-    for c in raw.chunks_exact(3) {
-        if c[0] != c[1] || c[1] != c[2] {
-            return None;
-        }
-        grey.push(c[0]);
+    if !raw.chunks_exact(3).all(|c| c[0] == c[1] && c[1] == c[2]) {
+        return None;
     }
+    let grey: Vec<u8> = raw.chunks_exact(3).map(|c| c[0]).collect();
     image::GrayImage::from_raw(rgb.width(), rgb.height(), grey)
 }
 
@@ -1055,6 +1054,25 @@ mod tests {
         let (colour, cov) = one(&plain).expect("one anti-aliased layer");
         assert!(cov.iter().filter(|&&c| c >= 0.5).count() > 40);
         assert_eq!(one(&layered), Some((colour, cov)));
+    }
+
+    /// A colour image whose every pixel is grey is its grey image; one
+    /// coloured pixel anywhere (the last one too) makes it a colour image.
+    #[test]
+    fn grey_of_rgb_reads_grey_pixels_and_refuses_colour() {
+        let (w, h) = (7u32, 5u32);
+        let grey: Vec<u8> = (0..w * h).map(|i| (i * 37 % 256) as u8).collect();
+        let rgb: Vec<u8> = grey.iter().flat_map(|&v| [v, v, v]).collect();
+        let img = image::RgbImage::from_raw(w, h, rgb.clone()).expect("sizes");
+        let got = grey_of_rgb(&img).expect("grey");
+        assert_eq!((got.width(), got.height()), (w, h));
+        assert_eq!(got.as_raw(), &grey);
+        for at in [0, 17, rgb.len() - 1] {
+            let mut c = rgb.clone();
+            c[at] ^= 1;
+            let img = image::RgbImage::from_raw(w, h, c).expect("sizes");
+            assert!(grey_of_rgb(&img).is_none(), "byte {at}");
+        }
     }
 
     /// The bin is `round_positive` of 255 × the clamped value, at every
