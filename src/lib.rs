@@ -442,8 +442,11 @@ pub fn looks_like_svg(bytes: &[u8]) -> bool {
 
 /// Reads a raster drawing (PNG, JPEG, …; a pen or pencil drawing, scanned
 /// or photographed) as a sketch: its lines traced along their centres
-/// ([`Image::lines_from_bytes`]) become open stroked path queries, each as
-/// wide as its line or `stroke_width` px. A drawing with no lines (blank
+/// ([`Image::lines_from_bytes`]) become open stroked path queries,
+/// `stroke_width` px wide when given, else as wide as their lines scaled
+/// up together until the median line is a 24th of the page's shorter side
+/// (so the ornament shows at the page's size; see
+/// `read::sketch::DRAWN_WIDTH_SHARE`). A drawing with no lines (blank
 /// paper) is an error.
 pub fn sketch_from_drawing(bytes: &[u8], stroke_width: Option<f64>) -> Result<Sketch> {
     let ink = read::ink::read_lines(bytes, &ImageOptions::default(), stroke_width)?;
@@ -466,6 +469,14 @@ pub fn sketch_from_drawing(bytes: &[u8], stroke_width: Option<f64>) -> Result<Sk
         strokes.into_iter().map(|s| (s.path, s.width)).collect(),
     );
     sketch.notes = ink.notes;
+    if stroke_width.is_none() {
+        if let Some((from, to)) = sketch.widen_drawn_lines() {
+            sketch.notes.push(format!(
+                "lines widened for the ornament: median {from:.1} px to {to:.1} px \
+                 (a 24th of the page's shorter side; --width sets every line's width)"
+            ));
+        }
+    }
     Ok(sketch)
 }
 

@@ -218,7 +218,8 @@ struct BrushArgs {
     /// Correction iterations per synthesis level, 0..=100 (0: graph cut upsampled only).
     #[arg(long, default_value_t = 1, value_name = "N")]
     iterations: usize,
-    /// For a PNG or JPEG drawing: every traced line this wide, in pixels.
+    /// For a PNG or JPEG drawing: every traced line this wide, in pixels (default: the lines'
+    /// widths scaled up together until the median is a 24th of the page's shorter side).
     #[arg(long, value_name = "PX")]
     width: Option<f64>,
 }
@@ -245,7 +246,8 @@ struct PatternArgs {
     /// Draw the elements and their spacing this many times larger, 0.01..=100.
     #[arg(long, default_value_t = 1.0, value_name = "F")]
     scale: f64,
-    /// For a PNG or JPEG drawing: every traced line this wide, in pixels.
+    /// For a PNG or JPEG drawing: every traced line this wide, in pixels (default: the lines'
+    /// widths scaled up together until the median is a 24th of the page's shorter side).
     #[arg(long, value_name = "PX")]
     width: Option<f64>,
 }

@@ -190,16 +190,15 @@ pub(super) fn pixel_partition(
 }
 
 /// `rgb` as a grey image when every pixel's three channels are equal,
-/// else `None` (found at the first coloured pixel).
+/// else `None` (found at the first coloured pixel). Checked in one pass
+/// and copied in another, which knows its length (no growth check per
+/// pixel).
 fn grey_of_rgb(rgb: &image::RgbImage) -> Option<image::GrayImage> {
     let raw = rgb.as_raw();
-    let mut grey = Vec::with_capacity(raw.len() / 3);
-    for c in raw.chunks_exact(3) {
-        if c[0] != c[1] || c[1] != c[2] {
-            return None;
-        }
-        grey.push(c[0]);
+    if !raw.chunks_exact(3).all(|c| c[0] == c[1] && c[1] == c[2]) {
+        return None;
     }
+    let grey: Vec<u8> = raw.chunks_exact(3).map(|c| c[0]).collect();
     image::GrayImage::from_raw(rgb.width(), rgb.height(), grey)
 }
 
@@ -213,13 +212,18 @@ pub(super) fn pixel_coverage(
     opts: &ImageOptions,
 ) -> RasterCoverage {
     let has_alpha = px.iter().any(|p| p[3] < 255);
-    if opts.layers {
-        RasterCoverage::Layers {
-            w,
-            h,
-            layers: quantized_layers(px, w, h, has_alpha, opts.invert, false),
-        }
+    let layers = if opts.layers {
+        quantized_layers(px, w, h, has_alpha, opts.invert, false)
     } else {
+        Vec::new()
+    };
+    if !layers.is_empty() {
+        RasterCoverage::Layers { w, h, layers }
+    } else {
+        // One layer: without `--layers`, or with it when no colour but the
+        // paper fills patches of its own (a drawing in thin anti-aliased
+        // lines, every ink pixel of which borders paper or a lighter edge
+        // pixel): the drawing is its one ink, read as without `--layers`.
         // Raw coverage (alpha, or darkness on an opaque image), then put on
         // the scale of the image's own paper and ink.
         let raw: Vec<f32> = px
@@ -485,14 +489,12 @@ impl InkScale {
 
     /// The scale of raw coverage values in 0..=1 (binned by 1/255).
     fn of_values(raw: &[f32]) -> InkScale {
-        let bin =
-            |c: f32| (crate::raster::round_positive(c.clamp(0.0, 1.0) * 255.0) as usize).min(255);
         let (counts, top) = raw
             .par_chunks(1 << 16)
             .map(|chunk| {
                 let (mut counts, mut top) = ([0u64; 256], [0f32; 256]);
                 for &c in chunk {
-                    let b = bin(c);
+                    let b = coverage_bin(c);
                     counts[b] += 1;
                     top[b] = top[b].max(c);
                 }
@@ -525,6 +527,21 @@ impl InkScale {
             return 0.0;
         }
         ((c - self.paper) / (self.ink - self.paper)).clamp(0.0, 1.0)
+    }
+}
+
+/// The bin (0..=255) of raw coverage `c` for [`InkScale::of_values`]:
+/// `c` held to 0..=1, times 255, rounded half up as
+/// [`crate::raster::round_positive`] rounds. Adding the half is exact from
+/// 0.5 up (a product under 256 has bits of fraction to spare); below it,
+/// where the float just under 0.5 would round up to 1, the bin is 0. The
+/// cast saturates.
+fn coverage_bin(c: f32) -> usize {
+    let x = c.clamp(0.0, 1.0) * 255.0;
+    if x < 0.5 {
+        0
+    } else {
+        ((x + 0.5) as usize).min(255)
     }
 }
 
@@ -998,6 +1015,100 @@ fn quantized_layers(
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    /// A drawing in one colour of thin anti-aliased lines has no palette
+    /// colour but the paper (no ink pixel has four neighbours of its own
+    /// colour): with `--layers` it is still traced, as one layer, the
+    /// coverage it has without `--layers`.
+    #[test]
+    fn layers_of_a_thin_line_drawing_are_its_one_ink() {
+        let (w, h) = (64usize, 48usize);
+        // A 1.2-px line from (4, 6) to (60, 40), anti-aliased by its
+        // distance, in dark blue on white.
+        let (a, b) = (kurbo::Point::new(4.0, 6.0), kurbo::Point::new(60.0, 40.0));
+        let px: Vec<[u8; 4]> = (0..w * h)
+            .map(|i| {
+                let p = kurbo::Point::new((i % w) as f64 + 0.5, (i / w) as f64 + 0.5);
+                let d = crate::raster::sdf::point_segment_distance(p, kurbo::Line::new(a, b));
+                let c = (0.6 - d + 0.5).clamp(0.0, 1.0);
+                let mix = |ink: f64| (255.0 * (1.0 - c) + ink * c).round() as u8;
+                [mix(20.0), mix(30.0), mix(90.0), 255]
+            })
+            .collect();
+        let plain = pixel_coverage(&px, w, h, &ImageOptions::default());
+        let layered = pixel_coverage(
+            &px,
+            w,
+            h,
+            &ImageOptions {
+                layers: true,
+                ..ImageOptions::default()
+            },
+        );
+        let one = |r: &RasterCoverage| match r {
+            RasterCoverage::Layers { layers, .. } if layers.len() == 1 => {
+                Some((layers[0].0, layers[0].1.data().to_vec()))
+            }
+            _ => None,
+        };
+        let (colour, cov) = one(&plain).expect("one anti-aliased layer");
+        assert!(cov.iter().filter(|&&c| c >= 0.5).count() > 40);
+        assert_eq!(one(&layered), Some((colour, cov)));
+    }
+
+    /// A colour image whose every pixel is grey is its grey image; one
+    /// coloured pixel anywhere (the last one too) makes it a colour image.
+    #[test]
+    fn grey_of_rgb_reads_grey_pixels_and_refuses_colour() {
+        let (w, h) = (7u32, 5u32);
+        let grey: Vec<u8> = (0..w * h).map(|i| (i * 37 % 256) as u8).collect();
+        let rgb: Vec<u8> = grey.iter().flat_map(|&v| [v, v, v]).collect();
+        let img = image::RgbImage::from_raw(w, h, rgb.clone()).expect("sizes");
+        let got = grey_of_rgb(&img).expect("grey");
+        assert_eq!((got.width(), got.height()), (w, h));
+        assert_eq!(got.as_raw(), &grey);
+        for at in [0, 17, rgb.len() - 1] {
+            let mut c = rgb.clone();
+            c[at] ^= 1;
+            let img = image::RgbImage::from_raw(w, h, c).expect("sizes");
+            assert!(grey_of_rgb(&img).is_none(), "byte {at}");
+        }
+    }
+
+    /// The bin is `round_positive` of 255 × the clamped value, at every
+    /// half-way point between bins and one and two ulps either side, at
+    /// the float just under 0.5 / 255, and out of range.
+    #[test]
+    fn coverage_bins_round_as_round_positive() {
+        let want =
+            |c: f32| (crate::raster::round_positive(c.clamp(0.0, 1.0) * 255.0) as usize).min(255);
+        let mut values = vec![
+            -1.0f32,
+            -0.0,
+            0.0,
+            1.0,
+            1.5,
+            f32::MIN_POSITIVE,
+            0.49999997 / 255.0,
+        ];
+        for k in 0..=256u32 {
+            for c in [(k as f32 + 0.5) / 255.0, k as f32 / 255.0] {
+                let b = c.to_bits();
+                values.extend([b - 2, b - 1, b, b + 1, b + 2].map(f32::from_bits));
+            }
+        }
+        for c in values {
+            assert_eq!(coverage_bin(c), want(c), "{c:e}");
+        }
+    }
+
+    proptest! {
+        #[test]
+        fn coverage_bins_match_round_positive_anywhere(c in -0.5f32..1.5) {
+            let want = (crate::raster::round_positive(c.clamp(0.0, 1.0) * 255.0) as usize).min(255);
+            prop_assert_eq!(coverage_bin(c), want);
+        }
+    }
 
     /// An opaque pixel's colour and key read off its bytes are the
     /// composite's, for every level of each channel.

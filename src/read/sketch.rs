@@ -254,7 +254,52 @@ impl Sketch {
         }
         out
     }
+
+    /// Widens the stroke queries of a sketch traced from a raster drawing
+    /// (see [`DRAWN_WIDTH_SHARE`]): every width times one factor, so the
+    /// median stroke (by count) becomes [`DRAWN_WIDTH_SHARE`] of the
+    /// page's shorter side; lines already that wide, and sketches without
+    /// strokes, stay. Returns the median width before and after (px) when
+    /// it widened.
+    pub(crate) fn widen_drawn_lines(&mut self) -> Option<(f64, f64)> {
+        let mut widths: Vec<f64> = self
+            .queries
+            .iter()
+            .filter_map(|q| match q.kind {
+                QueryKind::Path { width, .. } => Some(width),
+                QueryKind::Region { .. } => None,
+            })
+            .filter(|w| w.is_finite() && *w > 0.0)
+            .collect();
+        widths.sort_by(f64::total_cmp);
+        let median = *widths.get(widths.len() / 2)?;
+        let target = DRAWN_WIDTH_SHARE * self.width.min(self.height);
+        let k = target / median;
+        if !(k.is_finite() && k > 1.0) {
+            return None;
+        }
+        for q in &mut self.queries {
+            if let QueryKind::Path { width, .. } = &mut q.kind {
+                *width *= k;
+            }
+            if let Some(w) = &mut q.widths {
+                w.iter_mut().for_each(|v| *v *= k);
+            }
+        }
+        Some((median, target))
+    }
 }
+
+/// Share of the page's shorter side a raster drawing's median line is
+/// widened to when it becomes a sketch without `--width`
+/// ([`Sketch::widen_drawn_lines`]): a pencil line is 2–5 px wide on a
+/// photo thousands of pixels across, which as an ornament's width gives
+/// ornament too small to see at the page's size. A 24th of the shorter
+/// side is about 9 mm on an A4 sheet, 25 px on a 600-px scan: near the
+/// shipped brush sketches' widths (a 6th to a 12th of their shorter side,
+/// one or two strokes each) scaled for a page holding a whole drawing.
+/// The lines keep their widths relative to each other.
+pub const DRAWN_WIDTH_SHARE: f64 = 1.0 / 24.0;
 
 /// Reads and parses a sketch SVG file; errors name it.
 #[cfg(test)]
@@ -656,6 +701,41 @@ fn add_path(p: &usvg::Path, to_user: Affine, read: &mut Read, sk: &mut Sketch) -
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// One factor widens every stroke until the median one is
+    /// [`DRAWN_WIDTH_SHARE`] of the shorter side; wide lines stay.
+    #[test]
+    fn drawn_lines_are_widened_together_to_the_page_share() {
+        let line = |y: f64| {
+            BezPath::from_vec(vec![
+                kurbo::PathEl::MoveTo((10.0, y).into()),
+                kurbo::PathEl::LineTo((200.0, y).into()),
+            ])
+        };
+        let mut sk = Sketch::from_strokes(
+            600.0,
+            480.0,
+            vec![(line(10.0), 2.0), (line(50.0), 4.0), (line(90.0), 3.0)],
+        );
+        let (from, to) = sk.widen_drawn_lines().expect("widened");
+        assert_eq!((from, to), (3.0, 20.0));
+        let got: Vec<f64> = sk
+            .queries
+            .iter()
+            .filter_map(|q| match q.kind {
+                QueryKind::Path { width, .. } => Some(width),
+                QueryKind::Region { .. } => None,
+            })
+            .collect();
+        let want = [2.0, 4.0, 3.0].map(|w| w * 20.0 / 3.0);
+        for (g, w) in got.iter().zip(want) {
+            assert!((g - w).abs() < 1e-12, "{got:?}");
+        }
+        let mut wide = Sketch::from_strokes(600.0, 480.0, vec![(line(10.0), 30.0)]);
+        assert_eq!(wide.widen_drawn_lines(), None);
+        let mut empty = Sketch::from_strokes(600.0, 480.0, Vec::new());
+        assert_eq!(empty.widen_drawn_lines(), None);
+    }
 
     #[test]
     fn classifies_paths_and_regions() {

@@ -279,3 +279,51 @@ fn given_width_overrides_and_blank_paper_gives_no_strokes() {
     let ink = read_lines(&blank, &ImageOptions::default(), None).expect("reads");
     assert!(trace_lines(&ink.coverage, None, 0.25, 4.0).is_empty());
 }
+
+/// Paper to ornament without `--width`: a pencil drawing's lines (3 and
+/// 5 px) become queries widened together until the median is a 24th of
+/// the page's shorter side, in proportion; with `--width`, exactly that.
+#[test]
+fn a_drawing_sketch_is_widened_for_ornament_unless_a_width_is_given() {
+    let lines = [
+        Drawn {
+            pts: segment(Point::new(20.0, 30.0), Point::new(220.0, 40.0)),
+            width: 3.0,
+        },
+        Drawn {
+            pts: segment(Point::new(20.0, 120.0), Point::new(220.0, 150.0)),
+            width: 5.0,
+        },
+    ];
+    let (w, h) = (240, 192);
+    let png = pencil_png(&lines, w, h, 2);
+    let widths = |sk: &crate::Sketch| -> Vec<f64> {
+        sk.queries
+            .iter()
+            .filter_map(|q| match q.kind {
+                crate::read::sketch::QueryKind::Path { width, .. } => Some(width),
+                _ => None,
+            })
+            .collect()
+    };
+    let measured = trace(&lines, w, h, 2);
+    assert_eq!(measured.len(), 2);
+    let sk = crate::sketch_from_drawing(&png, None).expect("drawing reads");
+    let got = widths(&sk);
+    assert_eq!(got.len(), 2);
+    // The median of two is the wider line's (index len / 2).
+    let target = h as f64 / 24.0;
+    let k = target / measured[0].width.max(measured[1].width);
+    for (g, m) in got.iter().zip(&measured) {
+        assert!((g - k * m.width).abs() < 1e-9, "{g} vs {k} × {}", m.width);
+    }
+    assert!(got.iter().cloned().fold(0.0, f64::max) - target < 1e-9);
+    assert!(
+        sk.notes.iter().any(|n| n.contains("widened")),
+        "{:?}",
+        sk.notes
+    );
+    let sk = crate::sketch_from_drawing(&png, Some(6.0)).expect("drawing reads");
+    assert_eq!(widths(&sk), vec![6.0, 6.0]);
+    assert!(!sk.notes.iter().any(|n| n.contains("widened")));
+}
