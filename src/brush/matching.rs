@@ -227,6 +227,24 @@ pub struct Matching {
     pub cost: f64,
 }
 
+/// The longest run of consecutive segments that draw the same stretch of
+/// one exemplar (same exemplar, exemplar samples overlapping by more than
+/// half the shorter one's): 1 when no piece follows itself.
+#[cfg(test)]
+pub fn longest_repeat(segments: &[MatchedSegment]) -> usize {
+    let same = |a: &MatchedSegment, b: &MatchedSegment| {
+        let (ra, rb) = (&a.exemplar_samples, &b.exemplar_samples);
+        let common = ra.end.min(rb.end).saturating_sub(ra.start.max(rb.start));
+        a.exemplar == b.exemplar && 2 * common > ra.len().min(rb.len())
+    };
+    let (mut best, mut run) = (usize::from(!segments.is_empty()), 1);
+    for w in segments.windows(2) {
+        run = if same(&w[0], &w[1]) { run + 1 } else { 1 };
+        best = best.max(run);
+    }
+    best
+}
+
 /// Where along its spine a sample lies, for the end penalties.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Zone {

@@ -262,6 +262,28 @@ fn jumps_prefer_look_alike_boundaries() {
 }
 
 #[test]
+fn longest_repeat_counts_runs_of_one_stretch() {
+    let seg = |exemplar, r: Range<usize>| MatchedSegment {
+        exemplar,
+        core: 0..1,
+        query: 0..1,
+        exemplar_samples: r,
+    };
+    assert_eq!(longest_repeat(&[]), 0);
+    assert_eq!(longest_repeat(&[seg(0, 0..10)]), 1);
+    let chain = [seg(0, 2..10), seg(0, 3..11), seg(0, 2..9), seg(1, 2..9)];
+    assert_eq!(longest_repeat(&chain), 3);
+    // Another stretch of the same exemplar, or another exemplar, breaks it.
+    let apart = [
+        seg(0, 0..10),
+        seg(0, 10..20),
+        seg(1, 10..20),
+        seg(0, 10..20),
+    ];
+    assert_eq!(longest_repeat(&apart), 1);
+}
+
+#[test]
 fn bad_inputs_are_errors() {
     let q = straight(5, 1.0, 0.0);
     let empty = SpineFeatures {

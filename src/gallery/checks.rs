@@ -17,7 +17,10 @@
 //!   a width, none beyond 1.5 widths, no piece smaller than the exemplars'
 //!   smallest drawn element, structure density within 30 % of the
 //!   exemplars', line thicknesses closer to the exemplars' than half the
-//!   art brush's distance.
+//!   art brush's distance; in a library of several exemplars, no stretch
+//!   of one drawn more than twice in a row (`repeats`, the longest run of
+//!   consecutive matched segments on one exemplar stretch,
+//!   [`crate::brush::matching::longest_repeat`]).
 //! - trace: the render of the output matches the drawing's own render
 //!   (IoU of the ink at the bitmap's size); a drawing in several colours,
 //!   traced `--layers --cutout` too and rendered at 4× without
@@ -629,7 +632,11 @@ fn brush(style: &Path, input: &Path) -> Outcome {
     let figures = ExemplarFigures::of(bs);
     let (mut coverage, mut far, mut debris, mut density, mut thickness) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut repeats = Vec::new();
+    let ew = crate::brush::ribs::exemplar_width(bs)?;
     for (r, a) in out.queries.iter().zip(&art.queries) {
+        let (_, m) = crate::brush::pipeline::matched(bs, &r.spine, &keep, ew)?;
+        repeats.push(crate::brush::matching::longest_repeat(&m.segments) as f64);
         let mask = ink(bs, r);
         // Output px per finest exemplar px, where the exemplars' figures
         // are measured.
@@ -644,16 +651,21 @@ fn brush(style: &Path, input: &Path) -> Outcome {
         let stretched = figures.thickness_distance(&ink(bs, a), ka);
         thickness.push(own / stretched.max(1e-9));
     }
-    Ok((
-        out.document.to_svg(),
-        vec![
-            Check::at_least("coverage", worst(coverage.into_iter(), true, 0.0), 0.95),
-            Check::at_most("farthest", worst(far.into_iter(), false, 0.0), 1.5),
-            Check::at_least("debris", worst(debris.into_iter(), true, 1.0), 1.0),
-            Check::at_most("density", worst(density.into_iter(), false, 0.0), 0.3),
-            Check::at_most("thickness", worst(thickness.into_iter(), false, 0.0), 0.5),
-        ],
-    ))
+    let mut checks = vec![
+        Check::at_least("coverage", worst(coverage.into_iter(), true, 0.0), 0.95),
+        Check::at_most("farthest", worst(far.into_iter(), false, 0.0), 1.5),
+        Check::at_least("debris", worst(debris.into_iter(), true, 1.0), 1.0),
+        Check::at_most("density", worst(density.into_iter(), false, 0.0), 0.3),
+        Check::at_most("thickness", worst(thickness.into_iter(), false, 0.0), 0.5),
+    ];
+    if bs.exemplars.len() > 1 {
+        checks.push(Check::at_most(
+            "repeats",
+            worst(repeats.into_iter(), false, 0.0),
+            2.0,
+        ));
+    }
+    Ok((out.document.to_svg(), checks))
 }
 
 /// Ink pixels of an SVG rendered `w` × `h` px (dark or opaque enough:
