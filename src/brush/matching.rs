@@ -18,6 +18,11 @@
 //!   against the continuation of the one it leaves) and the squared
 //!   difference of the boundary thicknesses (rib lengths), so jumps
 //!   happen only where the two look alike all across the seam region;
+//! - a **repeat penalty** at a boundary that jumps back within the same
+//!   exemplar (the next segment starts on a sample at or before the one
+//!   the segment it leaves ends on, so it draws that stretch again), when
+//!   the library offers other exemplars: a run of one piece repeated as a
+//!   chain pays it at every link, so alternatives that look alike win;
 //! - a minimum and an optional maximum segment length (in samples).
 //!
 //! The minimum is found by dynamic programming over (query sample,
@@ -166,6 +171,9 @@ pub struct MatchOptions {
     /// Weight of the squared thickness difference over the mean width at a
     /// boundary (10).
     pub w_thickness: f64,
+    /// Cost added to a boundary that jumps back within the same exemplar
+    /// when there are other exemplars (default 10, a second jump penalty).
+    pub repeat_penalty: f64,
     /// Shortest segment, in samples (default 5; shorter queries are one
     /// segment).
     pub min_segment: usize,
@@ -196,6 +204,7 @@ impl Default for MatchOptions {
             jump_penalty: 10.0,
             w_appearance: 10.0,
             w_thickness: 10.0,
+            repeat_penalty: 20.0,
             min_segment: 5,
             max_segment: None,
             overlap: 4,
@@ -261,6 +270,9 @@ pub struct Problem<'a> {
     mean_width: f64,
     horizon: f64,
     zone: f64,
+    /// Whether more than one exemplar has samples (a repeat has an
+    /// alternative).
+    alternatives: bool,
 }
 
 impl<'a> Problem<'a> {
@@ -319,6 +331,7 @@ impl<'a> Problem<'a> {
             mean_width,
             horizon: opts.end_horizon.max(1e-9) * mean_width,
             zone: opts.end_zone * mean_width,
+            alternatives: exemplars.iter().filter(|e| !e.samples.is_empty()).count() > 1,
         })
     }
 
@@ -362,8 +375,9 @@ impl<'a> Problem<'a> {
 
     /// The cost of a boundary from exemplar sample `from` (the last of a
     /// segment) to `to` (the first of the next): the jump penalty, the
-    /// appearance difference over the overlap and the thickness
-    /// difference (see the module docs); infinite for samples out of range.
+    /// appearance difference over the overlap, the thickness difference
+    /// and the repeat penalty (see the module docs); infinite for samples
+    /// out of range.
     pub fn jump(&self, from: (usize, usize), to: (usize, usize)) -> f64 {
         let o = self.opts;
         let get = |(e, s): (usize, usize)| {
@@ -408,7 +422,12 @@ impl<'a> Problem<'a> {
                 _ => 0.0,
             }
         };
-        o.jump_penalty + o.w_appearance * app + o.w_thickness * dw * dw
+        let repeat = if self.alternatives && from.0 == to.0 && to.1 <= from.1 {
+            o.repeat_penalty
+        } else {
+            0.0
+        };
+        o.jump_penalty + o.w_appearance * app + o.w_thickness * dw * dw + repeat
     }
 
     /// Number of query samples.

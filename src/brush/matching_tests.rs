@@ -216,11 +216,12 @@ fn long_query_is_covered_by_several_segments() {
     assert_eq!(m.segments[0].exemplar_samples.start, 0);
     let last = &m.segments[m.segments.len() - 1];
     assert_eq!(last.exemplar_samples.end, 100);
-    // The exemplar whose turning matches (0.01 = 0.002 × 5) dominates.
+    // The exemplar whose turning matches (0.01 = 0.002 × 5) and its
+    // nearest neighbours (taken instead of repeating it) dominate.
     let owned: usize = m
         .segments
         .iter()
-        .filter(|s| s.exemplar == 5)
+        .filter(|s| (4..=6).contains(&s.exemplar))
         .map(|s| s.core.len())
         .sum();
     assert!(owned > 150, "{:?}", m.segments);
@@ -259,6 +260,38 @@ fn jumps_prefer_look_alike_boundaries() {
     for w in m.segments.windows(2) {
         assert_eq!(fam(w[0].exemplar), fam(w[1].exemplar), "{:?}", m.segments);
     }
+}
+
+#[test]
+fn a_piece_is_not_repeated_as_a_chain_when_there_are_alternatives() {
+    // Two short exemplars, the second a little wider than the query: a
+    // long query is covered by middles of the first over and over unless
+    // repeating a piece costs more than taking the other one.
+    let q = straight(80, 1.0, 0.0);
+    let ex = [straight(15, 1.0, 0.0), straight(15, 1.05, 0.0)];
+    let run = |repeat_penalty| {
+        let o = MatchOptions {
+            repeat_penalty,
+            ..MatchOptions::default()
+        };
+        let m = match_query(&q, &ex, &o).unwrap();
+        (longest_repeat(&m.segments), m.segments)
+    };
+    let (chain, segs) = run(0.0);
+    assert!(
+        chain > 2,
+        "without the penalty the best piece repeats: {segs:?}"
+    );
+    let (chain, segs) = run(MatchOptions::default().repeat_penalty);
+    assert!(chain <= 2, "{segs:?}");
+    assert!(segs.iter().any(|s| s.exemplar == 1), "{segs:?}");
+    // One exemplar alone has no alternative: it repeats as before.
+    let one = match_query(&q, &ex[..1], &MatchOptions::default()).unwrap();
+    let free = MatchOptions {
+        repeat_penalty: 0.0,
+        ..MatchOptions::default()
+    };
+    assert_eq!(one, match_query(&q, &ex[..1], &free).unwrap());
 }
 
 #[test]

@@ -477,6 +477,7 @@ fn compose(
         coords,
         orient,
         seam,
+        user: None,
     }
 }
 
