@@ -14,7 +14,11 @@
 //! - pattern (stroke-pattern-synthesis.txt §3): elements placed, their
 //!   nearest-neighbour spacing within 20 % of the example's.
 //! - brush (decobrush.txt §5–7): ink covers 95 % of the path within half
-//!   a width, none beyond 1.5 widths, no piece smaller than the exemplars'
+//!   a width, or 95 % of what the exemplars cover of their own spines
+//!   within half their width when that is less (an exemplar drawn on one
+//!   side of its spine, or a lattice with gaps along it, leaves some of
+//!   its spine bare: the ornament then must do as its exemplars do, not
+//!   more); none beyond 1.5 widths, no piece smaller than the exemplars'
 //!   smallest drawn element, structure density within 30 % of the
 //!   exemplars', line thicknesses closer to the exemplars' than half the
 //!   art brush's distance; in a library of several exemplars, no stretch
@@ -642,7 +646,7 @@ fn brush(style: &Path, input: &Path) -> Outcome {
         // are measured.
         let (k, ka) = (out_per_fine(bs, r), out_per_fine(bs, a));
         let f = Fidelity::of(r, &mask);
-        coverage.push(f.coverage);
+        coverage.push(f.coverage / figures.coverage.clamp(1e-9, 1.0));
         far.push(f.farthest);
         let smallest = (figures.smallest as f64 * k * k).round() as usize;
         debris.push(f.smallest.min(usize::MAX >> 1) as f64 / smallest.min(f.largest).max(1) as f64);
