@@ -35,8 +35,17 @@
 //! reaches the last sample),
 //! so the cost is O(query × candidates²); with unlimited candidates the DP is
 //! exact (tested against exhaustive enumeration of segmentations). Near-equal
-//! choices are broken by a hash of (seed, position, choice), so `--seed`
-//! varies the result deterministically.
+//! choices are broken by a hash of (seed, position, choice).
+//!
+//! Seed 0 (the default) draws the optimum. Any other seed draws one of the
+//! near-optimal matchings, as DecoBrush's randomized candidates make each
+//! run draw other pieces (decobrush.txt §5): the DP runs again with a seeded cost added to every data term, drawn per
+//! exemplar, per alignment of the exemplar to the query (a segment keeps
+//! one) and per stretch of the query, so each seed prefers other pieces in
+//! other places. The varied matching is kept when its true energy is within
+//! [`MatchOptions::slack`] of the optimum's, else the variation is halved and
+//! tried again, and after [`VARIATION_TRIES`] the optimum is drawn: every
+//! varied ornament costs at most that much more than the best one.
 
 use crate::brush::query::QuerySpine;
 use crate::error::{Error, Result};
@@ -183,8 +192,15 @@ pub struct MatchOptions {
     /// Samples by which each segment is extended into its neighbours
     /// (default 4).
     pub overlap: usize,
-    /// Seed of the tie-breaking hash.
+    /// Seed of the tie-breaking hash and of the variation.
     pub seed: u64,
+    /// Largest seeded cost added to a query sample's data term in the
+    /// varied search (default 0.5, about a sample's data term on a
+    /// well-matched stroke; 0 leaves the seed to break ties only).
+    pub variation: f64,
+    /// Energy a varied matching may cost above the optimum, relative to the
+    /// optimum's (default 0.03; 0 keeps the optimum).
+    pub slack: f64,
     /// Costs closer than this (relative) count as ties (default 1e-9).
     pub tie_tolerance: f64,
 }
@@ -209,6 +225,8 @@ impl Default for MatchOptions {
             max_segment: None,
             overlap: 4,
             seed: 0,
+            variation: 0.5,
+            slack: 0.03,
             tie_tolerance: 1e-9,
         }
     }
@@ -254,6 +272,14 @@ pub fn longest_repeat(segments: &[MatchedSegment]) -> usize {
     best
 }
 
+/// Length of a stretch of the query with one draw of the variation, in
+/// shortest segments.
+pub const VARIATION_STRETCH: usize = 4;
+
+/// Varied searches tried, halving the variation each time, before the
+/// optimum is drawn.
+pub const VARIATION_TRIES: usize = 3;
+
 /// Where along its spine a sample lies, for the end penalties.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Zone {
@@ -273,6 +299,8 @@ pub struct Problem<'a> {
     /// Whether more than one exemplar has samples (a repeat has an
     /// alternative).
     alternatives: bool,
+    /// Largest seeded cost added to each data term (0: the true energy).
+    vary: f64,
 }
 
 impl<'a> Problem<'a> {
@@ -332,7 +360,14 @@ impl<'a> Problem<'a> {
             horizon: opts.end_horizon.max(1e-9) * mean_width,
             zone: opts.end_zone * mean_width,
             alternatives: exemplars.iter().filter(|e| !e.samples.is_empty()).count() > 1,
+            vary: 0.0,
         })
+    }
+
+    /// The same problem with a seeded cost of up to `vary` added to every
+    /// data term (see the module docs).
+    fn varied(self, vary: f64) -> Self {
+        Problem { vary, ..self }
     }
 
     fn zone_of(&self, f: &SampleFeature) -> Zone {
@@ -362,6 +397,11 @@ impl<'a> Problem<'a> {
         let ds = clamp(a.dist_start) - clamp(b.dist_start);
         let de = clamp(a.dist_end) - clamp(b.dist_end);
         let mut c = o.w_turning * dt * dt + o.w_width * dw * dw + o.w_ends * (ds * ds + de * de);
+        if self.vary > 0.0 {
+            let stretch = (VARIATION_STRETCH * o.min_segment.max(1)) as u64;
+            let align = (s as i64 - q as i64) as u64;
+            c += self.vary * rng::unit(&[o.seed, 0x7A21, e as u64, align, q as u64 / stretch]);
+        }
         let (zq, ze) = (self.zone_of(a), self.zone_of(b));
         if zq != ze {
             c += if zq == Zone::Middle {
@@ -453,9 +493,22 @@ impl<'a> Problem<'a> {
         self.opts.max_segment.map(|m| m.max(self.min_segment()))
     }
 
+    /// The cost of matched segments whose cores tile the query, as the DP
+    /// counts it (data terms over the cores, a boundary cost between
+    /// consecutive cores).
+    pub fn cost_of_segments(&self, segs: &[MatchedSegment]) -> f64 {
+        let triples: Vec<(usize, usize, Range<usize>)> = segs
+            .iter()
+            .map(|m| {
+                let s0 = m.exemplar_samples.start + (m.core.start - m.query.start);
+                (m.exemplar, s0, m.core.clone())
+            })
+            .collect();
+        self.cost_of(&triples)
+    }
+
     /// The cost of a segmentation given as (exemplar, first exemplar sample,
     /// query range) triples tiling the query, as the DP counts it.
-    #[cfg(test)]
     pub fn cost_of(&self, segs: &[(usize, usize, Range<usize>)]) -> f64 {
         let mut c = 0.0;
         let mut last: Option<(usize, usize)> = None;
@@ -489,13 +542,45 @@ struct Layer {
 }
 
 /// Matches `query` against `exemplars` (decobrush.txt §5.1) and returns the
-/// segments, extended by `opts.overlap` samples into their neighbours.
+/// segments, extended by `opts.overlap` samples into their neighbours: the
+/// seed's near-optimal matching (see the module docs), with its true cost.
 pub fn match_query(
     query: &SpineFeatures,
     exemplars: &[SpineFeatures],
     opts: &MatchOptions,
 ) -> Result<Matching> {
-    match match_pruned(query, exemplars, opts) {
+    let best = match_search(query, exemplars, opts, 0.0)?;
+    if opts.seed == 0 || !(opts.slack > 0.0 && opts.variation > 0.0) {
+        return Ok(best);
+    }
+    let p = Problem::new(query, exemplars, opts)?;
+    let bound = best.cost + opts.slack * best.cost.abs();
+    let mut vary = opts.variation;
+    for _ in 0..VARIATION_TRIES {
+        if let Ok(m) = match_search(query, exemplars, opts, vary) {
+            let cost = p.cost_of_segments(&m.segments);
+            if cost <= bound {
+                return Ok(Matching {
+                    segments: m.segments,
+                    cost,
+                });
+            }
+        }
+        vary /= 2.0;
+    }
+    Ok(best)
+}
+
+/// The optimum of the problem with a seeded variation of up to `vary` on
+/// the data terms: the pruned search, or the exact one when pruning lost
+/// every complete segmentation.
+fn match_search(
+    query: &SpineFeatures,
+    exemplars: &[SpineFeatures],
+    opts: &MatchOptions,
+    vary: f64,
+) -> Result<Matching> {
+    match match_pruned(query, exemplars, opts, vary) {
         // The pruned search lost every complete segmentation (its kept
         // runs all ran off their exemplars' ends near the query's end):
         // the exact search over every exemplar sample finds one if any
@@ -507,6 +592,7 @@ pub fn match_query(
                 candidates: usize::MAX,
                 ..opts.clone()
             },
+            vary,
         ),
         r => r,
     }
@@ -518,8 +604,9 @@ fn match_pruned(
     query: &SpineFeatures,
     exemplars: &[SpineFeatures],
     opts: &MatchOptions,
+    vary: f64,
 ) -> Result<Matching> {
-    let p = Problem::new(query, exemplars, opts)?;
+    let p = Problem::new(query, exemplars, opts)?.varied(vary);
     let n = p.query_len();
     let lmin = p.min_segment();
     // Run-length slots per candidate: exact up to the maximum segment
