@@ -42,9 +42,10 @@
 //! run draw other pieces (decobrush.txt §5): the DP runs again with a seeded cost added to every data term, drawn per
 //! exemplar, per alignment of the exemplar to the query (a segment keeps
 //! one) and per stretch of the query, so each seed prefers other pieces in
-//! other places. The varied matching is kept when its true energy is within
-//! [`MatchOptions::slack`] of the optimum's, else the variation is halved and
-//! tried again, and after [`VARIATION_TRIES`] the optimum is drawn: every
+//! other places. The varied matching is kept when it differs from the
+//! optimum and its true energy is within [`MatchOptions::slack`] of the
+//! optimum's, else the variation is drawn again at half the size, and
+//! after [`VARIATION_TRIES`] the optimum is drawn: every
 //! varied ornament costs at most that much more than the best one.
 
 use crate::brush::query::QuerySpine;
@@ -276,8 +277,8 @@ pub fn longest_repeat(segments: &[MatchedSegment]) -> usize {
 /// shortest segments.
 pub const VARIATION_STRETCH: usize = 4;
 
-/// Varied searches tried, halving the variation each time, before the
-/// optimum is drawn.
+/// Varied searches tried, each with a new draw of half the previous
+/// variation, before the optimum is drawn.
 pub const VARIATION_TRIES: usize = 3;
 
 /// Where along its spine a sample lies, for the end penalties.
@@ -301,6 +302,8 @@ pub struct Problem<'a> {
     alternatives: bool,
     /// Largest seeded cost added to each data term (0: the true energy).
     vary: f64,
+    /// Which draw of the seeded cost (one per varied search).
+    draw: u64,
 }
 
 impl<'a> Problem<'a> {
@@ -361,13 +364,14 @@ impl<'a> Problem<'a> {
             zone: opts.end_zone * mean_width,
             alternatives: exemplars.iter().filter(|e| !e.samples.is_empty()).count() > 1,
             vary: 0.0,
+            draw: 0,
         })
     }
 
-    /// The same problem with a seeded cost of up to `vary` added to every
-    /// data term (see the module docs).
-    fn varied(self, vary: f64) -> Self {
-        Problem { vary, ..self }
+    /// The same problem with draw `draw` of a seeded cost of up to `vary`
+    /// added to every data term (see the module docs).
+    fn varied(self, vary: f64, draw: u64) -> Self {
+        Problem { vary, draw, ..self }
     }
 
     fn zone_of(&self, f: &SampleFeature) -> Zone {
@@ -400,7 +404,15 @@ impl<'a> Problem<'a> {
         if self.vary > 0.0 {
             let stretch = (VARIATION_STRETCH * o.min_segment.max(1)) as u64;
             let align = (s as i64 - q as i64) as u64;
-            c += self.vary * rng::unit(&[o.seed, 0x7A21, e as u64, align, q as u64 / stretch]);
+            let key = [
+                o.seed,
+                0x7A21,
+                self.draw,
+                e as u64,
+                align,
+                q as u64 / stretch,
+            ];
+            c += self.vary * rng::unit(&key);
         }
         let (zq, ze) = (self.zone_of(a), self.zone_of(b));
         if zq != ze {
@@ -549,17 +561,17 @@ pub fn match_query(
     exemplars: &[SpineFeatures],
     opts: &MatchOptions,
 ) -> Result<Matching> {
-    let best = match_search(query, exemplars, opts, 0.0)?;
+    let best = match_search(query, exemplars, opts, 0.0, 0)?;
     if opts.seed == 0 || !(opts.slack > 0.0 && opts.variation > 0.0) {
         return Ok(best);
     }
     let p = Problem::new(query, exemplars, opts)?;
     let bound = best.cost + opts.slack * best.cost.abs();
     let mut vary = opts.variation;
-    for _ in 0..VARIATION_TRIES {
-        if let Ok(m) = match_search(query, exemplars, opts, vary) {
+    for draw in 0..VARIATION_TRIES as u64 {
+        if let Ok(m) = match_search(query, exemplars, opts, vary, draw) {
             let cost = p.cost_of_segments(&m.segments);
-            if cost <= bound {
+            if cost <= bound && m.segments != best.segments {
                 return Ok(Matching {
                     segments: m.segments,
                     cost,
@@ -571,16 +583,17 @@ pub fn match_query(
     Ok(best)
 }
 
-/// The optimum of the problem with a seeded variation of up to `vary` on
-/// the data terms: the pruned search, or the exact one when pruning lost
-/// every complete segmentation.
+/// The optimum of the problem with draw `draw` of a seeded variation of up
+/// to `vary` on the data terms: the pruned search, or the exact one when
+/// pruning lost every complete segmentation.
 fn match_search(
     query: &SpineFeatures,
     exemplars: &[SpineFeatures],
     opts: &MatchOptions,
     vary: f64,
+    draw: u64,
 ) -> Result<Matching> {
-    match match_pruned(query, exemplars, opts, vary) {
+    match match_pruned(query, exemplars, opts, vary, draw) {
         // The pruned search lost every complete segmentation (its kept
         // runs all ran off their exemplars' ends near the query's end):
         // the exact search over every exemplar sample finds one if any
@@ -593,6 +606,7 @@ fn match_search(
                 ..opts.clone()
             },
             vary,
+            draw,
         ),
         r => r,
     }
@@ -605,8 +619,9 @@ fn match_pruned(
     exemplars: &[SpineFeatures],
     opts: &MatchOptions,
     vary: f64,
+    draw: u64,
 ) -> Result<Matching> {
-    let p = Problem::new(query, exemplars, opts)?.varied(vary);
+    let p = Problem::new(query, exemplars, opts)?.varied(vary, draw);
     let n = p.query_len();
     let lmin = p.min_segment();
     // Run-length slots per candidate: exact up to the maximum segment
