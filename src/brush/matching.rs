@@ -18,6 +18,11 @@
 //!   against the continuation of the one it leaves) and the squared
 //!   difference of the boundary thicknesses (rib lengths), so jumps
 //!   happen only where the two look alike all across the seam region;
+//! - a **repeat penalty** at a boundary that jumps back within the same
+//!   exemplar (the next segment starts on a sample at or before the one
+//!   the segment it leaves ends on, so it draws that stretch again), when
+//!   the library offers other exemplars: a run of one piece repeated as a
+//!   chain pays it at every link, so alternatives that look alike win;
 //! - a minimum and an optional maximum segment length (in samples).
 //!
 //! The minimum is found by dynamic programming over (query sample,
@@ -30,8 +35,18 @@
 //! reaches the last sample),
 //! so the cost is O(query × candidates²); with unlimited candidates the DP is
 //! exact (tested against exhaustive enumeration of segmentations). Near-equal
-//! choices are broken by a hash of (seed, position, choice), so `--seed`
-//! varies the result deterministically.
+//! choices are broken by a hash of (seed, position, choice).
+//!
+//! Seed 0 (the default) draws the optimum. Any other seed draws one of the
+//! near-optimal matchings, as DecoBrush's randomized candidates make each
+//! run draw other pieces (decobrush.txt §5): the DP runs again with a seeded cost added to every data term, drawn per
+//! exemplar, per alignment of the exemplar to the query (a segment keeps
+//! one) and per stretch of the query, so each seed prefers other pieces in
+//! other places. The varied matching is kept when it differs from the
+//! optimum and its true energy is within [`MatchOptions::slack`] of the
+//! optimum's, else the variation is drawn again at half the size, and
+//! after [`VARIATION_TRIES`] the optimum is drawn: every
+//! varied ornament costs at most that much more than the best one.
 
 use crate::brush::query::QuerySpine;
 use crate::error::{Error, Result};
@@ -166,6 +181,9 @@ pub struct MatchOptions {
     /// Weight of the squared thickness difference over the mean width at a
     /// boundary (10).
     pub w_thickness: f64,
+    /// Cost added to a boundary that jumps back within the same exemplar
+    /// when there are other exemplars (default 10, a second jump penalty).
+    pub repeat_penalty: f64,
     /// Shortest segment, in samples (default 5; shorter queries are one
     /// segment).
     pub min_segment: usize,
@@ -175,8 +193,15 @@ pub struct MatchOptions {
     /// Samples by which each segment is extended into its neighbours
     /// (default 4).
     pub overlap: usize,
-    /// Seed of the tie-breaking hash.
+    /// Seed of the tie-breaking hash and of the variation.
     pub seed: u64,
+    /// Largest seeded cost added to a query sample's data term in the
+    /// varied search (default 0.5, about a sample's data term on a
+    /// well-matched stroke; 0 leaves the seed to break ties only).
+    pub variation: f64,
+    /// Energy a varied matching may cost above the optimum, relative to the
+    /// optimum's (default 0.03; 0 keeps the optimum).
+    pub slack: f64,
     /// Costs closer than this (relative) count as ties (default 1e-9).
     pub tie_tolerance: f64,
 }
@@ -196,10 +221,13 @@ impl Default for MatchOptions {
             jump_penalty: 10.0,
             w_appearance: 10.0,
             w_thickness: 10.0,
+            repeat_penalty: 20.0,
             min_segment: 5,
             max_segment: None,
             overlap: 4,
             seed: 0,
+            variation: 0.5,
+            slack: 0.03,
             tie_tolerance: 1e-9,
         }
     }
@@ -227,6 +255,32 @@ pub struct Matching {
     pub cost: f64,
 }
 
+/// The longest run of consecutive segments that draw the same stretch of
+/// one exemplar (same exemplar, exemplar samples overlapping by more than
+/// half the shorter one's): 1 when no piece follows itself.
+#[cfg(test)]
+pub fn longest_repeat(segments: &[MatchedSegment]) -> usize {
+    let same = |a: &MatchedSegment, b: &MatchedSegment| {
+        let (ra, rb) = (&a.exemplar_samples, &b.exemplar_samples);
+        let common = ra.end.min(rb.end).saturating_sub(ra.start.max(rb.start));
+        a.exemplar == b.exemplar && 2 * common > ra.len().min(rb.len())
+    };
+    let (mut best, mut run) = (usize::from(!segments.is_empty()), 1);
+    for w in segments.windows(2) {
+        run = if same(&w[0], &w[1]) { run + 1 } else { 1 };
+        best = best.max(run);
+    }
+    best
+}
+
+/// Length of a stretch of the query with one draw of the variation, in
+/// shortest segments.
+pub const VARIATION_STRETCH: usize = 4;
+
+/// Varied searches tried, each with a new draw of half the previous
+/// variation, before the optimum is drawn.
+pub const VARIATION_TRIES: usize = 3;
+
 /// Where along its spine a sample lies, for the end penalties.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Zone {
@@ -243,6 +297,13 @@ pub struct Problem<'a> {
     mean_width: f64,
     horizon: f64,
     zone: f64,
+    /// Whether more than one exemplar has samples (a repeat has an
+    /// alternative).
+    alternatives: bool,
+    /// Largest seeded cost added to each data term (0: the true energy).
+    vary: f64,
+    /// Which draw of the seeded cost (one per varied search).
+    draw: u64,
 }
 
 impl<'a> Problem<'a> {
@@ -301,7 +362,16 @@ impl<'a> Problem<'a> {
             mean_width,
             horizon: opts.end_horizon.max(1e-9) * mean_width,
             zone: opts.end_zone * mean_width,
+            alternatives: exemplars.iter().filter(|e| !e.samples.is_empty()).count() > 1,
+            vary: 0.0,
+            draw: 0,
         })
+    }
+
+    /// The same problem with draw `draw` of a seeded cost of up to `vary`
+    /// added to every data term (see the module docs).
+    fn varied(self, vary: f64, draw: u64) -> Self {
+        Problem { vary, draw, ..self }
     }
 
     fn zone_of(&self, f: &SampleFeature) -> Zone {
@@ -331,6 +401,19 @@ impl<'a> Problem<'a> {
         let ds = clamp(a.dist_start) - clamp(b.dist_start);
         let de = clamp(a.dist_end) - clamp(b.dist_end);
         let mut c = o.w_turning * dt * dt + o.w_width * dw * dw + o.w_ends * (ds * ds + de * de);
+        if self.vary > 0.0 {
+            let stretch = (VARIATION_STRETCH * o.min_segment.max(1)) as u64;
+            let align = (s as i64 - q as i64) as u64;
+            let key = [
+                o.seed,
+                0x7A21,
+                self.draw,
+                e as u64,
+                align,
+                q as u64 / stretch,
+            ];
+            c += self.vary * rng::unit(&key);
+        }
         let (zq, ze) = (self.zone_of(a), self.zone_of(b));
         if zq != ze {
             c += if zq == Zone::Middle {
@@ -344,8 +427,9 @@ impl<'a> Problem<'a> {
 
     /// The cost of a boundary from exemplar sample `from` (the last of a
     /// segment) to `to` (the first of the next): the jump penalty, the
-    /// appearance difference over the overlap and the thickness
-    /// difference (see the module docs); infinite for samples out of range.
+    /// appearance difference over the overlap, the thickness difference
+    /// and the repeat penalty (see the module docs); infinite for samples
+    /// out of range.
     pub fn jump(&self, from: (usize, usize), to: (usize, usize)) -> f64 {
         let o = self.opts;
         let get = |(e, s): (usize, usize)| {
@@ -390,7 +474,12 @@ impl<'a> Problem<'a> {
                 _ => 0.0,
             }
         };
-        o.jump_penalty + o.w_appearance * app + o.w_thickness * dw * dw
+        let repeat = if self.alternatives && from.0 == to.0 && to.1 <= from.1 {
+            o.repeat_penalty
+        } else {
+            0.0
+        };
+        o.jump_penalty + o.w_appearance * app + o.w_thickness * dw * dw + repeat
     }
 
     /// Number of query samples.
@@ -416,9 +505,22 @@ impl<'a> Problem<'a> {
         self.opts.max_segment.map(|m| m.max(self.min_segment()))
     }
 
+    /// The cost of matched segments whose cores tile the query, as the DP
+    /// counts it (data terms over the cores, a boundary cost between
+    /// consecutive cores).
+    pub fn cost_of_segments(&self, segs: &[MatchedSegment]) -> f64 {
+        let triples: Vec<(usize, usize, Range<usize>)> = segs
+            .iter()
+            .map(|m| {
+                let s0 = m.exemplar_samples.start + (m.core.start - m.query.start);
+                (m.exemplar, s0, m.core.clone())
+            })
+            .collect();
+        self.cost_of(&triples)
+    }
+
     /// The cost of a segmentation given as (exemplar, first exemplar sample,
     /// query range) triples tiling the query, as the DP counts it.
-    #[cfg(test)]
     pub fn cost_of(&self, segs: &[(usize, usize, Range<usize>)]) -> f64 {
         let mut c = 0.0;
         let mut last: Option<(usize, usize)> = None;
@@ -452,13 +554,46 @@ struct Layer {
 }
 
 /// Matches `query` against `exemplars` (decobrush.txt §5.1) and returns the
-/// segments, extended by `opts.overlap` samples into their neighbours.
+/// segments, extended by `opts.overlap` samples into their neighbours: the
+/// seed's near-optimal matching (see the module docs), with its true cost.
 pub fn match_query(
     query: &SpineFeatures,
     exemplars: &[SpineFeatures],
     opts: &MatchOptions,
 ) -> Result<Matching> {
-    match match_pruned(query, exemplars, opts) {
+    let best = match_search(query, exemplars, opts, 0.0, 0)?;
+    if opts.seed == 0 || !(opts.slack > 0.0 && opts.variation > 0.0) {
+        return Ok(best);
+    }
+    let p = Problem::new(query, exemplars, opts)?;
+    let bound = best.cost + opts.slack * best.cost.abs();
+    let mut vary = opts.variation;
+    for draw in 0..VARIATION_TRIES as u64 {
+        if let Ok(m) = match_search(query, exemplars, opts, vary, draw) {
+            let cost = p.cost_of_segments(&m.segments);
+            if cost <= bound && m.segments != best.segments {
+                return Ok(Matching {
+                    segments: m.segments,
+                    cost,
+                });
+            }
+        }
+        vary /= 2.0;
+    }
+    Ok(best)
+}
+
+/// The optimum of the problem with draw `draw` of a seeded variation of up
+/// to `vary` on the data terms: the pruned search, or the exact one when
+/// pruning lost every complete segmentation.
+fn match_search(
+    query: &SpineFeatures,
+    exemplars: &[SpineFeatures],
+    opts: &MatchOptions,
+    vary: f64,
+    draw: u64,
+) -> Result<Matching> {
+    match match_pruned(query, exemplars, opts, vary, draw) {
         // The pruned search lost every complete segmentation (its kept
         // runs all ran off their exemplars' ends near the query's end):
         // the exact search over every exemplar sample finds one if any
@@ -470,6 +605,8 @@ pub fn match_query(
                 candidates: usize::MAX,
                 ..opts.clone()
             },
+            vary,
+            draw,
         ),
         r => r,
     }
@@ -481,8 +618,10 @@ fn match_pruned(
     query: &SpineFeatures,
     exemplars: &[SpineFeatures],
     opts: &MatchOptions,
+    vary: f64,
+    draw: u64,
 ) -> Result<Matching> {
-    let p = Problem::new(query, exemplars, opts)?;
+    let p = Problem::new(query, exemplars, opts)?.varied(vary, draw);
     let n = p.query_len();
     let lmin = p.min_segment();
     // Run-length slots per candidate: exact up to the maximum segment

@@ -105,15 +105,7 @@ fn extensions_are_bounded(p: &Problem, m: &Matching) -> Result<(), TestCaseError
 }
 
 fn core_cost(p: &Problem, m: &Matching) -> f64 {
-    let segs: Vec<_> = m
-        .segments
-        .iter()
-        .map(|s| {
-            let s0 = s.exemplar_samples.start + (s.core.start - s.query.start);
-            (s.exemplar, s0, s.core.clone())
-        })
-        .collect();
-    p.cost_of(&segs)
+    p.cost_of_segments(&m.segments)
 }
 
 proptest! {
@@ -134,10 +126,23 @@ proptest! {
             end_zone: 0.3,
             end_horizon: 1.0,
             seed,
+            slack: 0.0,
             ..MatchOptions::default()
         };
         let p = Problem::new(&query, &exemplars, &opts).unwrap();
         let brute = exhaustive(&p, 0, None);
+        // Every seed's varied matching is feasible when the optimum is,
+        // really costs what it reports, and stays within the slack.
+        let varied = MatchOptions { slack: 0.05, ..opts.clone() };
+        match match_query(&query, &exemplars, &varied) {
+            Ok(m) => {
+                prop_assert!(brute.is_finite());
+                prop_assert!((core_cost(&p, &m) - m.cost).abs() <= 1e-7 * (1.0 + brute));
+                prop_assert!(m.cost >= brute - 1e-7 * (1.0 + brute));
+                prop_assert!(m.cost <= brute * 1.05 + 1e-7 * (1.0 + brute), "{} vs {}", m.cost, brute);
+            }
+            Err(_) => prop_assert!(brute.is_infinite()),
+        }
         match match_query(&query, &exemplars, &opts) {
             Ok(m) => {
                 prop_assert!((m.cost - brute).abs() <= 1e-7 * (1.0 + brute), "{} vs {}", m.cost, brute);
@@ -165,7 +170,7 @@ proptest! {
         query in features(8),
         exemplars in proptest::collection::vec(features(6), 1..=3),
     ) {
-        let exact = MatchOptions { candidates: usize::MAX, min_segment: 2, ..MatchOptions::default() };
+        let exact = MatchOptions { candidates: usize::MAX, min_segment: 2, slack: 0.0, ..MatchOptions::default() };
         let pruned = MatchOptions { candidates: 3, beam: 2, ..exact.clone() };
         let p = Problem::new(&query, &exemplars, &pruned).unwrap();
         let (a, b) = (match_query(&query, &exemplars, &exact), match_query(&query, &exemplars, &pruned));
@@ -192,7 +197,7 @@ fn query_ends_take_exemplar_ends() {
     assert_eq!(last.exemplar_samples.end, 40);
     let o = MatchOptions::default();
     assert!(
-        m.cost <= o.jump_penalty + 1e-9,
+        m.cost <= o.jump_penalty * (1.0 + o.slack) + 1e-9,
         "one jump and no end penalty paid: {}",
         m.cost
     );
@@ -216,11 +221,12 @@ fn long_query_is_covered_by_several_segments() {
     assert_eq!(m.segments[0].exemplar_samples.start, 0);
     let last = &m.segments[m.segments.len() - 1];
     assert_eq!(last.exemplar_samples.end, 100);
-    // The exemplar whose turning matches (0.01 = 0.002 × 5) dominates.
+    // The exemplar whose turning matches (0.01 = 0.002 × 5) and its
+    // nearest neighbours (taken instead of repeating it) dominate.
     let owned: usize = m
         .segments
         .iter()
-        .filter(|s| s.exemplar == 5)
+        .filter(|s| (4..=6).contains(&s.exemplar))
         .map(|s| s.core.len())
         .sum();
     assert!(owned > 150, "{:?}", m.segments);
@@ -244,6 +250,48 @@ fn seed_breaks_ties_between_identical_exemplars() {
 }
 
 #[test]
+fn seeds_draw_other_near_optimal_matchings() {
+    // Five look-alike exemplars along a 300-sample query: the optimum is
+    // one segmentation, but many others cost barely more; each seed but 0
+    // must draw one of them (within the slack), and draw it again when
+    // asked; seed 0 draws the optimum.
+    let q = straight(300, 1.0, 0.01);
+    let ex: Vec<_> = (0..5)
+        .map(|i| straight(60 + 7 * i, 1.0, 0.009 + 0.0005 * i as f64))
+        .collect();
+    let exact = MatchOptions {
+        slack: 0.0,
+        ..MatchOptions::default()
+    };
+    let best = match_query(&q, &ex, &exact).unwrap();
+    assert_eq!(
+        best,
+        match_query(&q, &ex, &MatchOptions::default()).unwrap()
+    );
+    let p = Problem::new(&q, &ex, &exact).unwrap();
+    let mut seen = Vec::new();
+    for seed in 1..9 {
+        let o = MatchOptions {
+            seed,
+            ..MatchOptions::default()
+        };
+        let m = match_query(&q, &ex, &o).unwrap();
+        assert_eq!(m, match_query(&q, &ex, &o).unwrap(), "seed {seed} repeats");
+        assert!((p.cost_of_segments(&m.segments) - m.cost).abs() <= 1e-7 * (1.0 + m.cost));
+        assert!(
+            m.cost <= best.cost * (1.0 + o.slack) + 1e-9,
+            "{} vs {}",
+            m.cost,
+            best.cost
+        );
+        if !seen.contains(&m.segments) {
+            seen.push(m.segments);
+        }
+    }
+    assert!(seen.len() >= 6, "{} matchings in 8 seeds", seen.len());
+}
+
+#[test]
 fn jumps_prefer_look_alike_boundaries() {
     // Two exemplar families: appearance 0 and appearance 1. A boundary
     // between families pays w_appearance, so the query stays in one family.
@@ -259,6 +307,65 @@ fn jumps_prefer_look_alike_boundaries() {
     for w in m.segments.windows(2) {
         assert_eq!(fam(w[0].exemplar), fam(w[1].exemplar), "{:?}", m.segments);
     }
+}
+
+#[test]
+fn a_piece_is_not_repeated_as_a_chain_when_there_are_alternatives() {
+    // Two short exemplars, the second a little wider than the query: a
+    // long query is covered by middles of the first over and over unless
+    // repeating a piece costs more than taking the other one.
+    let q = straight(80, 1.0, 0.0);
+    let ex = [straight(15, 1.0, 0.0), straight(15, 1.05, 0.0)];
+    let run = |repeat_penalty| {
+        let o = MatchOptions {
+            repeat_penalty,
+            slack: 0.0,
+            ..MatchOptions::default()
+        };
+        let m = match_query(&q, &ex, &o).unwrap();
+        (longest_repeat(&m.segments), m.segments)
+    };
+    let (chain, segs) = run(0.0);
+    assert!(
+        chain > 2,
+        "without the penalty the best piece repeats: {segs:?}"
+    );
+    let (chain, segs) = run(MatchOptions::default().repeat_penalty);
+    assert!(chain <= 2, "{segs:?}");
+    assert!(segs.iter().any(|s| s.exemplar == 1), "{segs:?}");
+    // One exemplar alone has no alternative: it repeats as before.
+    let alone = MatchOptions {
+        slack: 0.0,
+        ..MatchOptions::default()
+    };
+    let one = match_query(&q, &ex[..1], &alone).unwrap();
+    let free = MatchOptions {
+        repeat_penalty: 0.0,
+        ..alone
+    };
+    assert_eq!(one, match_query(&q, &ex[..1], &free).unwrap());
+}
+
+#[test]
+fn longest_repeat_counts_runs_of_one_stretch() {
+    let seg = |exemplar, r: Range<usize>| MatchedSegment {
+        exemplar,
+        core: 0..1,
+        query: 0..1,
+        exemplar_samples: r,
+    };
+    assert_eq!(longest_repeat(&[]), 0);
+    assert_eq!(longest_repeat(&[seg(0, 0..10)]), 1);
+    let chain = [seg(0, 2..10), seg(0, 3..11), seg(0, 2..9), seg(1, 2..9)];
+    assert_eq!(longest_repeat(&chain), 3);
+    // Another stretch of the same exemplar, or another exemplar, breaks it.
+    let apart = [
+        seg(0, 0..10),
+        seg(0, 10..20),
+        seg(1, 10..20),
+        seg(0, 10..20),
+    ];
+    assert_eq!(longest_repeat(&apart), 1);
 }
 
 #[test]

@@ -170,6 +170,18 @@ pub(crate) fn min_branch(median_thickness: f64) -> usize {
     median_thickness.round().max(1.0) as usize
 }
 
+/// Whether `mask` has an ink pixel whose centre lies within `radius` px of
+/// `p` (px, pixel centres at half-integers).
+fn ink_within(mask: &Grid<bool>, p: Point, radius: f64) -> bool {
+    let lo = |v: f64| (v - radius - 0.5).floor().max(0.0) as usize;
+    let hi = |v: f64, n: usize| ((v + radius + 0.5).ceil().max(0.0) as usize).min(n);
+    (lo(p.y)..hi(p.y, mask.height())).any(|y| {
+        (lo(p.x)..hi(p.x, mask.width())).any(|x| {
+            mask.get(x, y) && Point::new(x as f64 + 0.5, y as f64 + 0.5).distance(p) <= radius
+        })
+    })
+}
+
 /// The median of a sample (0 when empty).
 pub(crate) fn median(v: &[f64]) -> f64 {
     let mut v = v.to_vec();
@@ -259,6 +271,10 @@ pub(crate) struct ExemplarFigures {
     /// The smallest drawn element, finest px²
     /// ([`crate::brush::analysis::facts::StyleFacts::smallest_piece`]).
     pub(crate) smallest: usize,
+    /// The exemplars' own coverage: the share of all their rib spine
+    /// samples with ink within half the exemplar width (as
+    /// [`Fidelity::coverage`] counts a query's), 0–1.
+    pub(crate) coverage: f64,
 }
 
 impl ExemplarFigures {
@@ -273,6 +289,18 @@ impl ExemplarFigures {
             .iter()
             .filter_map(|e| Some((e.finest()?.ink.ink.map(|v| v < 0.0), e.spine_length())))
             .collect();
+        let (mut covered, mut samples) = (0usize, 0usize);
+        for e in &style.exemplars {
+            let Some(level) = e.finest() else { continue };
+            let mask = level.ink.ink.map(|v| v < 0.0);
+            samples += e.ribs.spine.len();
+            covered += e
+                .ribs
+                .spine
+                .iter()
+                .filter(|p| ink_within(&mask, Point::new(p[0], p[1]), 0.5 * ew))
+                .count();
+        }
         let thick: Vec<f64> = masks.iter().flat_map(|(m, _)| thicknesses(m)).collect();
         let t = median(&thick);
         let (spur, hole) = (min_branch(t), (t * t).round() as usize);
@@ -287,6 +315,11 @@ impl ExemplarFigures {
             hole,
             density,
             smallest: style.facts.smallest_piece,
+            coverage: if samples == 0 {
+                1.0
+            } else {
+                covered as f64 / samples as f64
+            },
         }
     }
 

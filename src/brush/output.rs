@@ -578,6 +578,7 @@ pub fn debris_area(style: &BrushStyle) -> f64 {
 /// query's field (or a copy of it), used up.
 fn final_layers_with(style: &BrushStyle, r: &QueryResult, field: Field) -> Vec<(Color, Grid<i16>)> {
     let rings = border_rings(r);
+    let field_user = field.user.clone();
     let reach = Reach::of(&field.coords, rings);
     let field = extend_owned(style, field, rings);
     let jac = Jacobians::of(style, &field);
@@ -598,8 +599,16 @@ fn final_layers_with(style: &BrushStyle, r: &QueryResult, field: Field) -> Vec<(
     let scale = out_per_fine(style, r);
     let smallest = (debris_area(style) * scale * scale).round() as usize;
     let min = smallest.min(largest);
+    // A piece drawn where a refinement sketch asked for ink is the
+    // user's, not debris.
+    let sub = r.sub.max(1);
+    let asked = |i: usize| {
+        field_user
+            .as_ref()
+            .is_some_and(|u| u.get_or(((i % w) / sub) as isize, ((i / w) / sub) as isize, false))
+    };
     for comp in comps {
-        if comp.len() >= min {
+        if comp.len() >= min || comp.iter().any(|&i| asked(i)) {
             continue;
         }
         for (_, g) in &mut layers {
@@ -770,6 +779,7 @@ fn finish_query(
             coords: Grid::new(0, 0, None),
             orient: Grid::new(0, 0, [0.0; 2]),
             seam: Grid::new(0, 0, false),
+            user: None,
         };
         let field = std::mem::replace(&mut r.field, empty);
         r.levels = Vec::new();

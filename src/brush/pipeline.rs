@@ -478,6 +478,7 @@ fn compose(
         coords,
         orient,
         seam,
+        user: None,
     }
 }
 

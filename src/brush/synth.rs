@@ -62,6 +62,9 @@ pub struct Field {
     /// Seam regions (overlaps of matched segments), where the ANN search
     /// runs.
     pub seam: Grid<bool>,
+    /// Pixels a refinement sketch marked (§5.5), when there was one: the
+    /// ink the user asked for there is kept even as a piece apart.
+    pub user: Option<Grid<bool>>,
 }
 
 /// Synthesis parameters.
@@ -593,6 +596,10 @@ pub fn upsample(style: &BrushStyle, field: &Field) -> Field {
         coords,
         orient: Grid::from_fn(w, h, |x, y| field.orient.get(x / 2, y / 2)),
         seam: Grid::from_fn(w, h, |x, y| field.seam.get(x / 2, y / 2)),
+        user: field
+            .user
+            .as_ref()
+            .map(|u| Grid::from_fn(w, h, |x, y| u.get(x / 2, y / 2))),
     }
 }
 
@@ -675,6 +682,7 @@ fn seed_from_target(
 /// level, coarse to fine, the masked pixels take the nearest exemplar
 /// neighbourhood of the target (no coherence) and are then corrected
 /// inside the mask only; outside it the original coordinates stay locked.
+/// The refined field remembers the mask ([`Field::user`]).
 pub fn refine(
     style: &BrushStyle,
     levels: &[Field],
@@ -714,6 +722,9 @@ pub fn refine(
         seed_from_target(style, &mut next, target, &mk, down(k))?;
         correct_in(style, &mut next, opts, Some(&mk));
         field = next;
+    }
+    if field.coords.width() == mask.width() && field.coords.height() == mask.height() {
+        field.user = Some(mask.clone());
     }
     Some(field)
 }

@@ -17,10 +17,17 @@
 //!   share of ink drawn twice, each element rendered on its own at 4 px
 //!   per unit).
 //! - brush (decobrush.txt §5–7): ink covers 95 % of the path within half
-//!   a width, none beyond 1.5 widths, no piece smaller than the exemplars'
+//!   a width, or 95 % of what the exemplars cover of their own spines
+//!   within half their width when that is less (an exemplar drawn on one
+//!   side of its spine, or a lattice with gaps along it, leaves some of
+//!   its spine bare: the ornament then must do as its exemplars do, not
+//!   more); none beyond 1.5 widths, no piece smaller than the exemplars'
 //!   smallest drawn element, structure density within 30 % of the
 //!   exemplars', line thicknesses closer to the exemplars' than half the
-//!   art brush's distance.
+//!   art brush's distance; in a library of several exemplars, no stretch
+//!   of one drawn more than twice in a row (`repeats`, the longest run of
+//!   consecutive matched segments on one exemplar stretch,
+//!   [`crate::brush::matching::longest_repeat`]).
 //! - trace: the render of the output matches the drawing's own render
 //!   (IoU of the ink at the bitmap's size); a drawing in several colours,
 //!   traced `--layers --cutout` too and rendered at 4× without
@@ -695,12 +702,23 @@ fn overlapping_ink<'a>(
     })
 }
 
+/// The brush cases' seed: `FLOURISH_GALLERY_SEED`, or 0. The shortfalls
+/// are listed for seed 0 (the optimal matching); another seed measures
+/// how the seeded near-optimal matchings fare.
+fn brush_seed() -> u64 {
+    std::env::var("FLOURISH_GALLERY_SEED")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(0)
+}
+
 fn brush(style: &Path, input: &Path) -> Outcome {
     let st = load(style)?;
     let bs = st.brush()?;
     let sk = sketch::load(input)?;
     let keep = Settings {
         discard_fields: false,
+        seed: brush_seed(),
         ..Settings::default()
     };
     let out = brush_sketch(bs, &sk, &keep)?;
@@ -715,13 +733,17 @@ fn brush(style: &Path, input: &Path) -> Outcome {
     let figures = ExemplarFigures::of(bs);
     let (mut coverage, mut far, mut debris, mut density, mut thickness) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut repeats = Vec::new();
+    let ew = crate::brush::ribs::exemplar_width(bs)?;
     for (r, a) in out.queries.iter().zip(&art.queries) {
+        let (_, m) = crate::brush::pipeline::matched(bs, &r.spine, &keep, ew)?;
+        repeats.push(crate::brush::matching::longest_repeat(&m.segments) as f64);
         let mask = ink(bs, r);
         // Output px per finest exemplar px, where the exemplars' figures
         // are measured.
         let (k, ka) = (out_per_fine(bs, r), out_per_fine(bs, a));
         let f = Fidelity::of(r, &mask);
-        coverage.push(f.coverage);
+        coverage.push(f.coverage / figures.coverage.clamp(1e-9, 1.0));
         far.push(f.farthest);
         let smallest = (figures.smallest as f64 * k * k).round() as usize;
         debris.push(f.smallest.min(usize::MAX >> 1) as f64 / smallest.min(f.largest).max(1) as f64);
@@ -730,16 +752,21 @@ fn brush(style: &Path, input: &Path) -> Outcome {
         let stretched = figures.thickness_distance(&ink(bs, a), ka);
         thickness.push(own / stretched.max(1e-9));
     }
-    Ok((
-        out.document.to_svg(),
-        vec![
-            Check::at_least("coverage", worst(coverage.into_iter(), true, 0.0), 0.95),
-            Check::at_most("farthest", worst(far.into_iter(), false, 0.0), 1.5),
-            Check::at_least("debris", worst(debris.into_iter(), true, 1.0), 1.0),
-            Check::at_most("density", worst(density.into_iter(), false, 0.0), 0.3),
-            Check::at_most("thickness", worst(thickness.into_iter(), false, 0.0), 0.5),
-        ],
-    ))
+    let mut checks = vec![
+        Check::at_least("coverage", worst(coverage.into_iter(), true, 0.0), 0.95),
+        Check::at_most("farthest", worst(far.into_iter(), false, 0.0), 1.5),
+        Check::at_least("debris", worst(debris.into_iter(), true, 1.0), 1.0),
+        Check::at_most("density", worst(density.into_iter(), false, 0.0), 0.3),
+        Check::at_most("thickness", worst(thickness.into_iter(), false, 0.0), 0.5),
+    ];
+    if bs.exemplars.len() > 1 {
+        checks.push(Check::at_most(
+            "repeats",
+            worst(repeats.into_iter(), false, 0.0),
+            2.0,
+        ));
+    }
+    Ok((out.document.to_svg(), checks))
 }
 
 /// Ink pixels of an SVG rendered `w` × `h` px (dark or opaque enough:

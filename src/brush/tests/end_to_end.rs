@@ -146,6 +146,7 @@ fn correction_leaves_an_exact_exemplar_copy_unchanged() {
             coords,
             orient,
             seam: Grid::from_fn(w, h, |x, y| lv.orientation.mask.get(x, y)),
+            user: None,
         };
         let before = field.clone();
         synth::correct(style, &mut field, &SynthOptions::default());

@@ -122,6 +122,7 @@ fn a_field_is_continued_as_a_whole_canvas_scan_continues_it() {
             |x, _| if x % 3 == 0 { [0.6, 0.8] } else { [1.0, 0.0] },
         ),
         seam: Grid::new(w, h, false),
+        user: None,
         coords,
     };
     for rings in [1, 4, 12] {
