@@ -1094,7 +1094,9 @@ mod tests {
         for k in 0..=256u32 {
             for c in [(k as f32 + 0.5) / 255.0, k as f32 / 255.0] {
                 let b = c.to_bits();
-                values.extend([b - 2, b - 1, b, b + 1, b + 2].map(f32::from_bits));
+                values.extend(
+                    [b.saturating_sub(2), b.saturating_sub(1), b, b + 1, b + 2].map(f32::from_bits),
+                );
             }
         }
         for c in values {
