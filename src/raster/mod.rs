@@ -157,6 +157,20 @@ pub fn round_positive(x: f32) -> f32 {
     }
 }
 
+/// `x` held to 0..=255 and rounded half up, as [`round_positive`] rounds,
+/// in one add and one saturating cast: adding the half is exact from 0.5
+/// up (a value under 256 has at least 16 bits of fraction to spare);
+/// below it, where the float just under 0.5 would round up to 1, the
+/// answer is 0. NaN gives 0.
+#[inline]
+pub fn round_to_byte(x: f32) -> u8 {
+    if x < 0.5 {
+        0
+    } else {
+        (x + 0.5) as u8
+    }
+}
+
 /// Ink coverage of one layer: 0 (paper) to 1 (ink) per pixel, anti-aliased
 /// edges kept as fractional coverage.
 pub type Coverage = Grid<f32>;

@@ -532,17 +532,10 @@ impl InkScale {
 
 /// The bin (0..=255) of raw coverage `c` for [`InkScale::of_values`]:
 /// `c` held to 0..=1, times 255, rounded half up as
-/// [`crate::raster::round_positive`] rounds. Adding the half is exact from
-/// 0.5 up (a product under 256 has bits of fraction to spare); below it,
-/// where the float just under 0.5 would round up to 1, the bin is 0. The
-/// cast saturates.
+/// [`crate::raster::round_positive`] rounds
+/// ([`crate::raster::round_to_byte`]).
 fn coverage_bin(c: f32) -> usize {
-    let x = c.clamp(0.0, 1.0) * 255.0;
-    if x < 0.5 {
-        0
-    } else {
-        ((x + 0.5) as usize).min(255)
-    }
+    usize::from(crate::raster::round_to_byte(c.clamp(0.0, 1.0) * 255.0))
 }
 
 /// Largest distance (RGB, 0..=1 per channel) from the mix of paper and

@@ -221,19 +221,10 @@ impl Lighting {
     }
 }
 
-/// `v` times `gain` (positive), rounded half up and held to 0..=255 (what
-/// [`crate::raster::round_positive`] gives): the whole part of the
-/// product plus a half, cast with saturation. Adding the half is exact
-/// from 0.5 up (a product under 256 has at least 16 bits of fraction to
-/// spare); below it, where the float just under 0.5 would round up to 1,
-/// the answer is 0.
+/// `v` times `gain` (positive), rounded half up and held to 0..=255
+/// ([`crate::raster::round_to_byte`]).
 fn scaled(v: u8, gain: f32) -> u8 {
-    let x = f32::from(v) * gain;
-    if x < 0.5 {
-        0
-    } else {
-        (x + 0.5) as u8
-    }
+    crate::raster::round_to_byte(f32::from(v) * gain)
 }
 
 /// The surface `coef` at terms `t`.
