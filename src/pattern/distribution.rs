@@ -278,9 +278,7 @@ impl Distribution {
             area,
         }
     }
-}
 
-impl Distribution {
     /// Distance between neighbours when the elements are laid in a chain
     /// along a path, reference units: a row keeps its own spacing; a field's
     /// chain takes the field's mean nearest-neighbour distance, so that each

@@ -381,8 +381,8 @@ fn too_many(n: f64, limit: usize) -> std::result::Result<(), String> {
 /// pitch; 2 rows for a row example), it is 1-D: seeds in a chain at the
 /// example's [chain spacing](Distribution::chain_spacing) (those that would
 /// come closer than [`CROWDED`] spacings to another where the path turns
-/// back on itself are left out), elements turned with the path, variation never moving a centre more than width/2
-/// off the path. A wider band is filled in 2-D in path coordinates (arc
+/// back on itself are left out), elements turned with the path, variation
+/// never moving a centre more than width/2 off the path. A wider band is filled in 2-D in path coordinates (arc
 /// length, offset): the band is straightened into a length × width
 /// rectangle, synthesized like a region and bent back along the path.
 pub fn along_path(
