@@ -75,23 +75,40 @@ impl Check {
     fn at_least(name: &str, value: f64, min: f64) -> Check {
         Check {
             name: name.into(),
-            value: Some(value),
-            ok: value >= min,
+            value: None,
+            ok: false,
             higher_is_better: true,
             wanted: format!("≥ {min}"),
             limit: Some(min),
         }
+        .measured(value)
     }
 
     /// A figure that must be at most `max`.
     fn at_most(name: &str, value: f64, max: f64) -> Check {
         Check {
             name: name.into(),
-            value: Some(value),
-            ok: value <= max,
+            value: None,
+            ok: false,
             higher_is_better: false,
             wanted: format!("≤ {max}"),
             limit: Some(max),
+        }
+        .measured(value)
+    }
+
+    /// This check with figure `value`, judged against its threshold (a
+    /// recorded figure keeps its verdict).
+    fn measured(self, value: f64) -> Check {
+        let ok = match self.limit {
+            Some(l) if self.higher_is_better => value >= l,
+            Some(l) => value <= l,
+            None => self.ok,
+        };
+        Check {
+            value: Some(value),
+            ok,
+            ..self
         }
     }
 
@@ -387,16 +404,7 @@ fn over_seeds(default: &[u64], run: impl Fn(u64) -> Outcome) -> Outcome {
                 return c;
             }
             values.sort_by(f64::total_cmp);
-            let v = values[(values.len() - 1) / 2];
-            Check {
-                value: Some(v),
-                ok: match c.limit {
-                    Some(l) if c.higher_is_better => v >= l,
-                    Some(l) => v <= l,
-                    None => c.ok,
-                },
-                ..c
-            }
+            c.measured(values[(values.len() - 1) / 2])
         })
         .collect();
     Ok((svg, checks))
