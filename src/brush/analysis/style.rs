@@ -2,7 +2,7 @@
 //! spine, ribs, orientation) and the neighbourhood index of each level.
 //! What [`super::cache`] stores and [`super::BrushStyle::load`] returns.
 
-use super::exemplar::{InkLevel, LEVELS};
+use super::exemplar::{InkLevel, Layer, LEVELS};
 use super::facts::StyleFacts;
 #[cfg(test)]
 use super::neighbourhood::Neighbourhood;
@@ -67,18 +67,37 @@ fn no_layers() -> Grid<u8> {
     Grid::new(0, 0, PAPER_LAYER)
 }
 
+/// Per pixel of a `w`×`h` level, the index of the topmost of `layers`
+/// (bottom first) with ink there (negative distance), [`PAPER_LAYER`]
+/// where none has; layers beyond the 255th count as the 255th, and a
+/// layer grid smaller than the level is paper beyond its edge.
+fn top_layers(layers: &[Layer], w: usize, h: usize) -> Grid<u8> {
+    let mut top = vec![PAPER_LAYER; w * h];
+    // Each layer written over the ones below leaves the topmost.
+    for (i, l) in layers.iter().enumerate().filter(|_| w > 0) {
+        let index = i.min(PAPER_LAYER as usize - 1) as u8;
+        let cols = w.min(l.sdf.width());
+        if cols == 0 {
+            continue;
+        }
+        let rows = l.sdf.data().chunks_exact(l.sdf.width());
+        for (row, dist) in top.chunks_exact_mut(w).zip(rows) {
+            for (t, &d) in row[..cols].iter_mut().zip(&dist[..cols]) {
+                if d < 0.0 {
+                    *t = index;
+                }
+            }
+        }
+    }
+    Grid::from_vec(w, h, top).unwrap_or_else(no_layers)
+}
+
 impl ExemplarLevel {
     /// Sets [`ExemplarLevel::top`] from the layers (layers beyond the
     /// 255th count as the 255th).
     pub fn index_layers(&mut self) {
-        let layers = &self.ink.layers;
         let (w, h) = (self.ink.ink.width(), self.ink.ink.height());
-        self.top = Grid::from_fn(w, h, |x, y| {
-            layers
-                .iter()
-                .rposition(|l| l.sdf.get_or(x as isize, y as isize, 1.0) < 0.0)
-                .map_or(PAPER_LAYER, |i| i.min(PAPER_LAYER as usize - 1) as u8)
-        });
+        self.top = top_layers(&self.ink.layers, w, h);
     }
 
     /// Width in pixels.
@@ -264,4 +283,47 @@ pub fn region_refs(exemplars: &[&Exemplar], l: usize) -> Vec<NeighbourhoodRef> {
         }
     }
     refs
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::svg_out::Color;
+
+    /// The per-pixel definition: the last layer with ink at the pixel.
+    fn top_by_search(layers: &[Layer], w: usize, h: usize) -> Grid<u8> {
+        Grid::from_fn(w, h, |x, y| {
+            layers
+                .iter()
+                .rposition(|l| l.sdf.get_or(x as isize, y as isize, 1.0) < 0.0)
+                .map_or(PAPER_LAYER, |i| i.min(PAPER_LAYER as usize - 1) as u8)
+        })
+    }
+
+    #[test]
+    fn top_layers_match_a_search_through_the_layers() {
+        let layer = |lw: usize, lh: usize, seed: usize| Layer {
+            color: Color { r: 0, g: 0, b: 0 },
+            sdf: Grid::from_fn(lw, lh, |x, y| {
+                ((x * 7 + y * 13 + seed * 5) % 11) as f32 - 5.0
+            }),
+        };
+        // Layers of the level's size, smaller and larger than it.
+        let layers = vec![
+            layer(9, 6, 0),
+            layer(5, 4, 1),
+            layer(12, 8, 2),
+            layer(9, 6, 3),
+        ];
+        for (w, h) in [(9, 6), (1, 1), (0, 0), (11, 3)] {
+            let fast = top_layers(&layers, w, h);
+            let slow = top_by_search(&layers, w, h);
+            assert_eq!((fast.width(), fast.height()), (w, h));
+            assert_eq!(fast.data(), slow.data(), "{w}×{h}");
+        }
+        assert!(top_layers(&[], 3, 2)
+            .data()
+            .iter()
+            .all(|&t| t == PAPER_LAYER));
+    }
 }
