@@ -709,6 +709,14 @@ impl Palette {
             .into_par_iter()
             .map(|band| {
                 let mut hist: Vec<Bin> = vec![(0, 0, [0.0; 3]); 1 << 12];
+                // An opaque pixel's colour is its bytes: summed as
+                // integers, and as floats once per band (exact either
+                // way, so the sums are the same).
+                let mut bytes: Vec<[u64; 3]> = if has_alpha {
+                    Vec::new()
+                } else {
+                    vec![[0; 3]; 1 << 12]
+                };
                 for y in band * BAND..((band + 1) * BAND).min(h) {
                     let row = y * w;
                     for x in 0..w {
@@ -727,10 +735,20 @@ impl Palette {
                         };
                         e.0 += 1;
                         e.1 += u64::from(interior);
-                        for (sum, v) in e.2.iter_mut().zip(rgb(&px[i])) {
-                            *sum += v as f64;
+                        if let Some(b) = bytes.get_mut(usize::from(k)) {
+                            let p = &px[i];
+                            for (sum, &v) in b.iter_mut().zip(p) {
+                                *sum += u64::from(v);
+                            }
+                        } else {
+                            for (sum, v) in e.2.iter_mut().zip(rgb(&px[i])) {
+                                *sum += v as f64;
+                            }
                         }
                     }
+                }
+                for (e, b) in hist.iter_mut().zip(&bytes) {
+                    e.2 = b.map(|v| v as f64);
                 }
                 hist
             })

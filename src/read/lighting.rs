@@ -182,28 +182,36 @@ impl Lighting {
     /// along a row is a cubic in `u` whose coefficients are read off the
     /// two-variable one once per row and evaluated by Horner's rule (the
     /// same polynomial, to rounding).
-    fn row_gains<'a>(&'a self, y: usize, us: &'a [f64]) -> impl Iterator<Item = f32> + 'a {
+    ///
+    /// Written into `gains` (one per column) in a loop of its own, which
+    /// the compiler vectorizes; the pixels are then scaled in another.
+    fn fill_row_gains(&self, y: usize, us: &[f64], gains: &mut [f32]) {
         let v = 2.0 * (y as f64 + 0.5) / self.height as f64 - 1.0;
         let c = &self.coef;
         let a0 = c[0] + v * (c[2] + v * (c[5] + v * c[9]));
         let a1 = c[1] + v * (c[4] + v * c[8]);
         let a2 = c[3] + v * c[7];
         let a3 = c[6];
-        us.iter().map(move |&u| {
-            let paper = (a0 + u * (a1 + u * (a2 + u * a3))).max(self.darkest);
-            (self.brightest / paper) as f32
-        })
+        let (darkest, brightest) = (self.darkest, self.brightest);
+        for (g, &u) in gains.iter_mut().zip(us) {
+            let paper = (a0 + u * (a1 + u * (a2 + u * a3))).max(darkest);
+            *g = (brightest / paper) as f32;
+        }
     }
 
     /// Evens out the light of grey pixels (0..=255, row by row) in place.
     pub fn flatten_grey(&self, grey: &mut [u8]) {
         let w = self.width.max(1);
         let us = self.columns();
-        grey.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-            for (v, g) in row.iter_mut().zip(self.row_gains(y, &us)) {
-                *v = scaled(*v, g);
-            }
-        });
+        grey.par_chunks_mut(w).enumerate().for_each_init(
+            || vec![0f32; w],
+            |gains, (y, row)| {
+                self.fill_row_gains(y, &us, gains);
+                for (v, &g) in row.iter_mut().zip(gains.iter()) {
+                    *v = scaled(*v, g);
+                }
+            },
+        );
     }
 
     /// Evens out the light of RGBA pixels (row by row) in place: each
@@ -211,13 +219,16 @@ impl Lighting {
     pub fn flatten_rgba(&self, px: &mut [[u8; 4]]) {
         let w = self.width.max(1);
         let us = self.columns();
-        px.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
-            for (p, g) in row.iter_mut().zip(self.row_gains(y, &us)) {
-                for c in &mut p[..3] {
-                    *c = scaled(*c, g);
+        px.par_chunks_mut(w).enumerate().for_each_init(
+            || vec![0f32; w],
+            |gains, (y, row)| {
+                self.fill_row_gains(y, &us, gains);
+                for (p, &g) in row.iter_mut().zip(gains.iter()) {
+                    let [r, gr, b, a] = *p;
+                    *p = [scaled(r, g), scaled(gr, g), scaled(b, g), a];
                 }
-            }
-        });
+            },
+        );
     }
 }
 
@@ -386,12 +397,13 @@ mod tests {
         let light = |u: f64, v: f64| 0.95 - 0.5 * (0.7 * u * u * u + 0.3 * v - 0.2 * u * v * v);
         let img = photo(w, h, light);
         let l = Lighting::measure(w, h, at(&img, w)).expect("uneven");
+        let mut gains = vec![0f32; w];
         for y in 0..h {
-            for (x, g) in l.row_gains(y, &l.columns()).enumerate() {
+            l.fill_row_gains(y, &l.columns(), &mut gains);
+            for (x, &g) in gains.iter().enumerate() {
                 let want = l.gain(x, y);
                 assert!((g - want).abs() <= 1e-6 * want, "({x}, {y}): {g} vs {want}");
             }
-            assert_eq!(l.row_gains(y, &l.columns()).count(), w);
         }
     }
 
