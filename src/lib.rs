@@ -141,7 +141,7 @@ pub fn fill<'a>(
         opts
     };
     let out = in_px(sketch, opts.scale, |sk| {
-        let out = fill::fill_sketch(
+        let out = fill::fill_document(
             sk,
             |q| {
                 let s = styles.of(q)?;

@@ -649,13 +649,16 @@ fn synthesize_levels(
                     steps: params.steps,
                     band: r as f32 + 2.0,
                 };
-                // Layers evolve independently: one task each.
-                st.phi
-                    .par_iter_mut()
-                    .zip(&votes.sdf)
-                    .for_each(|(phi, (mean, count))| {
-                        levelset::evolve(phi, mean, count, &ev, live);
-                    });
+                // Layers evolve independently: one task each, as many at
+                // once as the memory allowance for them holds.
+                let k = super::layers_at_once(st.phi.len(), w * h);
+                for (phis, sdfs) in st.phi.chunks_mut(k).zip(votes.sdf.chunks(k)) {
+                    phis.par_iter_mut()
+                        .zip(sdfs)
+                        .for_each(|(phi, (mean, count))| {
+                            levelset::evolve(phi, mean, count, &ev, live);
+                        });
+                }
 
                 st.colour = votes.colour;
                 lambda += 0.75 / full as f32;
@@ -968,9 +971,19 @@ fn vote(pb: &Problem, nnf: &Nnf, lv: &Level, hist: &[[f32; 2]], w: usize, h: usi
     let aw = lv.source.atlas.width as i64;
     let stride = layers + 3;
     let tv = &lv.texels;
-    let rows: Vec<RowVote> = (0..h)
-        .into_par_iter()
-        .map(|y| {
+    // Each row gathers its sums and writes its means straight into the
+    // result (the layers' means interleaved per pixel), so no more than a
+    // row's sums per thread are held beside it.
+    let lw = layers.max(1);
+    let mut means = vec![0.0f32; w * h * lw];
+    let mut counts = vec![0.0f32; w * h];
+    let mut colours = vec![[1.0f32; 3]; w * h];
+    means
+        .par_chunks_mut((w * lw).max(1))
+        .zip(counts.par_chunks_mut(w.max(1)))
+        .zip(colours.par_chunks_mut(w.max(1)))
+        .enumerate()
+        .for_each(|(y, ((mean_row, count_row), colour_row))| {
             let mut row = RowVote {
                 sdf: vec![0.0; w * layers],
                 sdf_weight: vec![0.0; w * layers],
@@ -1023,40 +1036,38 @@ fn vote(pb: &Problem, nnf: &Nnf, lv: &Level, hist: &[[f32; 2]], w: usize, h: usi
                     }
                 }
             }
-            row
-        })
-        .collect();
-    let mut sdf: Vec<(Grid<f32>, Grid<f32>)> = (0..layers)
-        .map(|_| (Grid::new(w, h, 0.0), Grid::new(w, h, 0.0)))
-        .collect();
-    let mut colour = Grid::new(w, h, [1.0f32; 3]);
-    for (y, row) in rows.into_iter().enumerate() {
-        for x in 0..w {
-            let n = row.count[x];
-            for (l, (mean, cnt)) in sdf.iter_mut().enumerate() {
-                mean.set(
-                    x,
-                    y,
-                    if n > 0.0 && row.sdf_weight[x * layers + l] > 0.0 {
-                        row.sdf[x * layers + l] / row.sdf_weight[x * layers + l]
+            for x in 0..w {
+                let n = row.count[x];
+                for l in 0..layers {
+                    let (i, o) = (x * layers + l, x * lw + l);
+                    mean_row[o] = if n > 0.0 && row.sdf_weight[i] > 0.0 {
+                        row.sdf[i] / row.sdf_weight[i]
                     } else {
                         0.0
-                    },
-                );
-                cnt.set(x, y, n);
-            }
-            let ws = row.weight[x];
-            colour.set(
-                x,
-                y,
-                if ws > 0.0 {
+                    };
+                }
+                count_row[x] = n;
+                let ws = row.weight[x];
+                colour_row[x] = if ws > 0.0 {
                     row.colour[x].map(|c| c / ws)
                 } else {
                     [1.0; 3]
-                },
-            );
-        }
-    }
+                };
+            }
+        });
+    let count = Grid::from_vec(w, h, counts).unwrap_or_else(|| Grid::new(w, h, 0.0));
+    let sdf: Vec<(Grid<f32>, Grid<f32>)> = if layers == 1 {
+        let mean = Grid::from_vec(w, h, means).unwrap_or_else(|| Grid::new(w, h, 0.0));
+        vec![(mean, count)]
+    } else {
+        (0..layers)
+            .map(|l| {
+                let mean = Grid::from_fn(w, h, |x, y| means[(y * w + x) * lw + l]);
+                (mean, count.clone())
+            })
+            .collect()
+    };
+    let colour = Grid::from_vec(w, h, colours).unwrap_or_else(|| Grid::new(w, h, [1.0; 3]));
     Votes { sdf, colour }
 }
 

@@ -99,17 +99,17 @@ pub fn step(
     next.par_chunks_mut(w.max(1))
         .enumerate()
         .for_each(|(y, row)| {
+            // The rows above and below, clamped at the grid's edge.
+            let data = src.data();
+            let line = |yy: usize| &data[yy * w..(yy + 1) * w];
+            let (up, mid, down) = (line(y.saturating_sub(1)), line(y), line((y + 1).min(h - 1)));
             let value = |x: usize| -> f32 {
-                let c = src.get(x, y);
+                let c = mid[x];
                 if c.abs() >= ev.band || live.is_some_and(|l| !l.moves(x, y)) {
                     return c;
                 }
-                let at = |dx: isize, dy: isize| {
-                    let xx = (x as isize + dx).clamp(0, w as isize - 1) as usize;
-                    let yy = (y as isize + dy).clamp(0, h as isize - 1) as usize;
-                    src.get(xx, yy)
-                };
-                let (l, r, u, d) = (at(-1, 0), at(1, 0), at(0, -1), at(0, 1));
+                let (xl, xr) = (x.saturating_sub(1), (x + 1).min(w - 1));
+                let (l, r, u, d) = (mid[xl], mid[xr], up[x], down[x]);
                 // One-sided differences.
                 let (dmx, dpx, dmy, dpy) = (c - l, r - c, c - u, d - c);
                 let fs = if weight.get(x, y) > 0.0 {
@@ -136,7 +136,7 @@ pub fn step(
                 let py = 0.5 * (d - u);
                 let pxx = r - 2.0 * c + l;
                 let pyy = d - 2.0 * c + u;
-                let pxy = 0.25 * (at(1, 1) - at(1, -1) - at(-1, 1) + at(-1, -1));
+                let pxy = 0.25 * (down[xr] - up[xr] - down[xl] + up[xl]);
                 let g2 = px * px + py * py;
                 let kappa_grad = if g2 > 1e-12 {
                     (pxx * py * py - 2.0 * px * py * pxy + pyy * px * px) / g2

@@ -274,10 +274,10 @@ impl FillStyle {
 pub struct RegionFill {
     /// The query's id.
     pub id: String,
-    /// The region on its grid.
+    /// The region on its grid (its grids empty from [`fill_document`]).
     pub region: Region,
     /// Clipped layer SDFs (bottom first, the ground not among them),
-    /// region grid pixels.
+    /// region grid pixels (none from [`fill_document`]).
     pub layers: Vec<Grid<f32>>,
     /// Layer colours.
     pub colors: Vec<Color>,
@@ -411,10 +411,34 @@ fn exemplars_of(
 /// Fills every region query of a parsed sketch, each with the style
 /// `style_of` gives it (with its name, for the notes); open paths inside a
 /// region (and those of `opts.direction`) comb its direction field.
+#[cfg_attr(not(test), allow(dead_code))] // the tests and the gallery read the grids
 pub fn fill_sketch<'s>(
     sk: &Sketch,
     style_of: impl Fn(&Query) -> Result<(&'s str, &'s FillStyle)>,
     opts: &FillOptions,
+) -> Result<FillOutput> {
+    fill_regions(sk, style_of, opts, true)
+}
+
+/// [`fill_sketch`] for its document alone: each region's grids (its
+/// [`RegionFill::region`] rasters and [`RegionFill::layers`]) are let go
+/// once it is traced, so a sketch of many regions holds one region's
+/// grids at a time; they are left empty in the output.
+pub fn fill_document<'s>(
+    sk: &Sketch,
+    style_of: impl Fn(&Query) -> Result<(&'s str, &'s FillStyle)>,
+    opts: &FillOptions,
+) -> Result<FillOutput> {
+    fill_regions(sk, style_of, opts, false)
+}
+
+/// [`fill_sketch`], keeping each region's grids in the output when
+/// `keep_grids`.
+fn fill_regions<'s>(
+    sk: &Sketch,
+    style_of: impl Fn(&Query) -> Result<(&'s str, &'s FillStyle)>,
+    opts: &FillOptions,
+    keep_grids: bool,
 ) -> Result<FillOutput> {
     opts.validate()?;
     let mut strokes: Vec<(Vec<Point>, f64)> = Vec::new();
@@ -521,19 +545,31 @@ pub fn fill_sketch<'s>(
             tolerance: opts.tolerance,
             min_area: 2.0,
         };
-        // Layers trace independently, one task each, in layer order.
+        // Layers trace independently, one task each (as many at once as
+        // the memory allowance for them holds), in layer order.
+        let k = layers_at_once(layers.len(), region.width() * region.height());
         let paths = layers
-            .par_iter()
-            .map(|l| {
-                trace_sdf(
-                    &Sdf {
-                        dist: l.clone(),
-                        to_user: region.sdf.to_user,
-                    },
-                    &topts,
-                )
+            .chunks(k.max(1))
+            .flat_map(|group| {
+                group
+                    .par_iter()
+                    .map(|l| {
+                        trace_sdf(
+                            &Sdf {
+                                dist: l.clone(),
+                                to_user: region.sdf.to_user,
+                            },
+                            &topts,
+                        )
+                    })
+                    .collect::<Vec<_>>()
             })
             .collect();
+        let (region, layers) = if keep_grids {
+            (region, layers)
+        } else {
+            (region.without_grids(), Vec::new())
+        };
         out.push(RegionFill {
             id: q.id.clone(),
             colors: st.tiles[0].layers.iter().map(|l| l.color).collect(),
@@ -632,6 +668,35 @@ pub fn check(style: &FillStyle) -> Vec<String> {
         .collect();
     lines.extend(style.notes.iter().cloned());
     lines
+}
+
+/// Bytes one colour layer's E-step or tracing holds per pixel of the
+/// region's grid while it runs: the stepped copy, the reinitialization's
+/// contour, inside mask, band distances and two distance transforms, or
+/// the traced copy with its coverage and outline.
+const LAYER_BYTES_PER_PX: u64 = 40;
+
+/// The share of the memory budget (one part in this many) that colour
+/// layers running side by side may take beyond the first: 64 MB of the
+/// default 1 GiB, so a run's peak stays near that of one layer at a time.
+const PARALLEL_LAYERS_SHARE: u64 = 16;
+
+/// How many of `layers` colour layers of a grid of `px` pixels evolve or
+/// trace at once: one, plus as many more as fit in the allowance
+/// ([`PARALLEL_LAYERS_SHARE`] of the budget, and what is left of it) at
+/// [`LAYER_BYTES_PER_PX`]. The result does not depend on it (layers are
+/// independent and collected in order).
+pub fn layers_at_once(layers: usize, px: usize) -> usize {
+    layers_within(layers, px, crate::memory::budget(), crate::memory::held())
+}
+
+/// [`layers_at_once`] under a budget of `budget` bytes of which `held`
+/// are taken.
+fn layers_within(layers: usize, px: usize, budget: u64, held: u64) -> usize {
+    let each = (px as u64).saturating_mul(LAYER_BYTES_PER_PX).max(1);
+    let room = (budget / PARALLEL_LAYERS_SHARE).min(budget.saturating_sub(held));
+    let more = usize::try_from(room / each).unwrap_or(usize::MAX);
+    more.saturating_add(1).min(layers.max(1))
 }
 
 /// Bytes a region's synthesis holds per pixel of its grid and of its

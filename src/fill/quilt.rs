@@ -187,16 +187,20 @@ fn quilt_blocks(
             let overlap_err = |sx: usize, sy: usize, bound: f32| -> f32 {
                 let lin = &q.linear[beta(sx, sy)];
                 let base = (sy * ch.width + sx) * d;
-                let mut e = 0.0f32;
-                for (&i, a) in offsets.iter().zip(present.chunks_exact(d)) {
-                    let at = base.wrapping_add_signed(lin[i]);
-                    let c = &ch.data[at..at + d];
-                    e += a.iter().zip(c).map(|(p, q)| (p - q) * (p - q)).sum::<f32>();
-                    if e > bound {
-                        return f32::INFINITY;
-                    }
+                let o = Overlap {
+                    data: &ch.data,
+                    base,
+                    linear: lin,
+                    offsets: &offsets,
+                    present: &present,
+                };
+                match d {
+                    4 => o.error::<4>(bound),
+                    5 => o.error::<5>(bound),
+                    6 => o.error::<6>(bound),
+                    7 => o.error::<7>(bound),
+                    _ => o.error_any(d, bound),
                 }
-                e
             };
             // Every allowed centre when there are few, else a seeded
             // sample. A candidate is kept only when its error is within
@@ -293,6 +297,65 @@ fn quilt_blocks(
         by += step;
     }
     map
+}
+
+/// One candidate block's overlap with what earlier blocks laid: the
+/// atlas channels, the candidate centre's channel index, the turned
+/// offsets' channel index offsets, the overlap's block offsets (indices
+/// into `linear`) and the channels already there (`depth` per offset).
+struct Overlap<'a> {
+    data: &'a [f32],
+    base: usize,
+    linear: &'a [isize],
+    offsets: &'a [usize],
+    present: &'a [f32],
+}
+
+impl Overlap<'_> {
+    /// The squared channel difference summed in row-major order, one
+    /// pixel's `D` channels at a time; infinity once over `bound` (the sum
+    /// only grows) or where an offset leaves the atlas.
+    #[inline]
+    fn error<const D: usize>(&self, bound: f32) -> f32 {
+        let mut e = 0.0f32;
+        for (&i, a) in self.offsets.iter().zip(self.present.chunks_exact(D)) {
+            let at = self.base.wrapping_add_signed(self.linear[i]);
+            let (Some(c), Ok(a)) = (
+                self.data
+                    .get(at..at.wrapping_add(D))
+                    .and_then(|s| <&[f32; D]>::try_from(s).ok()),
+                <&[f32; D]>::try_from(a),
+            ) else {
+                return f32::INFINITY;
+            };
+            let mut px = 0.0f32;
+            for k in 0..D {
+                let t = a[k] - c[k];
+                px += t * t;
+            }
+            e += px;
+            if e > bound {
+                return f32::INFINITY;
+            }
+        }
+        e
+    }
+
+    /// [`Overlap::error`] for any depth.
+    fn error_any(&self, d: usize, bound: f32) -> f32 {
+        let mut e = 0.0f32;
+        for (&i, a) in self.offsets.iter().zip(self.present.chunks_exact(d)) {
+            let at = self.base.wrapping_add_signed(self.linear[i]);
+            let Some(c) = self.data.get(at..at.wrapping_add(d)) else {
+                return f32::INFINITY;
+            };
+            e += a.iter().zip(c).map(|(p, q)| (p - q) * (p - q)).sum::<f32>();
+            if e > bound {
+                return f32::INFINITY;
+            }
+        }
+        e
+    }
 }
 
 /// The block centres that continue the blocks laid to the left of and

@@ -31,6 +31,20 @@ pub struct Region {
 }
 
 impl Region {
+    /// The region with its grids let go (0×0) and its area kept: what
+    /// remains once it is filled and traced.
+    pub fn without_grids(self) -> Region {
+        Region {
+            mask: Grid::new(0, 0, false),
+            sdf: Sdf {
+                dist: Grid::new(0, 0, 0.0),
+                to_user: self.sdf.to_user,
+            },
+            direction: Grid::new(0, 0, [0.0; 2]),
+            area: self.area,
+        }
+    }
+
     /// Rasterizes `outline` (sketch units) at `px_per_unit`, with `margin`
     /// pixels around its bounding box. Fails (naming `file` and `id`) when
     /// the grid is over the size limit or no pixel centre is inside.

@@ -801,3 +801,42 @@ fn several_swatches_in_several_colours_give_identical_bytes_on_one_and_two_threa
         assert!(one.contains(c), "{c} missing");
     }
 }
+
+/// Colour layers run side by side only while their working memory fits
+/// the allowance: all three of a letter-sized grid under the default
+/// budget, one at a time on the largest grid or with the budget spent,
+/// never none and never more than there are.
+#[test]
+fn layers_run_side_by_side_only_within_the_memory_allowance() {
+    use super::layers_within;
+    let gib = 1u64 << 30;
+    assert_eq!(layers_within(3, 567 * 732, gib, 0), 3);
+    assert_eq!(layers_within(3, 8 << 20, gib, 0), 1);
+    assert_eq!(layers_within(3, 567 * 732, gib, gib), 1);
+    assert_eq!(layers_within(0, 10, gib, 0), 1);
+    assert_eq!(layers_within(2, 0, u64::MAX, 0), 2);
+    // The allowance divided by a layer's bytes, plus the first.
+    let px = 1 << 20;
+    let each = px as u64 * super::LAYER_BYTES_PER_PX;
+    let want = (gib / super::PARALLEL_LAYERS_SHARE / each) as usize + 1;
+    assert_eq!(layers_within(64, px, gib, 0), want);
+}
+
+/// `fill_document` gives `fill_sketch`'s document, bit for bit, with every
+/// region's grids let go.
+#[test]
+fn the_document_alone_is_the_same_document_without_the_grids() {
+    let sk = sketch::load(&sample("letter")).unwrap();
+    let st = FillStyle::load(&root().join("styles").join("scales"), Some(64)).unwrap();
+    let opts = FillOptions::default();
+    let full = fill_sketch(&sk, |_| Ok(("scales", &st)), &opts).unwrap();
+    let lean = super::fill_document(&sk, |_| Ok(("scales", &st)), &opts).unwrap();
+    assert_eq!(full.to_document().to_svg(), lean.to_document().to_svg());
+    assert!(!full.regions.is_empty());
+    for (f, l) in full.regions.iter().zip(&lean.regions) {
+        assert!(!f.layers.is_empty() && f.region.mask.width() > 0);
+        assert!(l.layers.is_empty());
+        assert_eq!(l.region.mask.data().len(), 0);
+        assert_eq!(l.region.area, f.region.area);
+    }
+}

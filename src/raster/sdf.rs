@@ -196,6 +196,9 @@ fn distance_to_segments(inside: &Grid<bool>, segments: &[Line]) -> Grid<f32> {
             b.push(i as u32);
         }
     }
+    // Least distance per pixel; a segment's square root is taken only
+    // when its squared distance is below the square of the one held (an
+    // `f32` squared is exact in `f64`, so the test loses nothing).
     let mut near = vec![f32::INFINITY; w * h];
     near.par_chunks_mut(STRIP * w.max(1))
         .enumerate()
@@ -210,13 +213,19 @@ fn distance_to_segments(inside: &Grid<bool>, segments: &[Line]) -> Grid<f32> {
                 let y0 = ((l.p0.y.min(l.p1.y) - band - 0.5).floor().max(0.0) as usize).max(row0);
                 let y1 = ((l.p0.y.max(l.p1.y) + band - 0.5).ceil().max(0.0) as usize)
                     .min(row0 + nrows - 1);
+                let d = l.p1 - l.p0;
+                let len2 = d.hypot2();
                 for y in y0..=y1 {
-                    for x in x0..=x1 {
+                    let row = &mut rows[(y - row0) * w..(y - row0 + 1) * w];
+                    for (x, slot) in row.iter_mut().enumerate().take(x1 + 1).skip(x0) {
                         let p = Point::new(x as f64 + 0.5, y as f64 + 0.5);
-                        let d = point_segment_distance(p, l) as f32;
-                        let slot = &mut rows[(y - row0) * w + x];
-                        if d < *slot {
-                            *slot = d;
+                        let d2 = point_segment_distance2(p, l.p0, d, len2);
+                        let held = *slot as f64;
+                        if d2 < held * held {
+                            let d = d2.sqrt() as f32;
+                            if d < *slot {
+                                *slot = d;
+                            }
                         }
                     }
                 }
@@ -252,6 +261,20 @@ fn distance_to_segments(inside: &Grid<bool>, segments: &[Line]) -> Grid<f32> {
         })
         .collect();
     Grid::from_vec(w, h, data).expect("sizes match by construction")
+}
+
+/// Squared Euclidean distance from `p` to the segment from `p0` along
+/// `d` (`len2` = `|d|²`), with the nearest point found as in
+/// [`point_segment_distance`].
+#[inline]
+fn point_segment_distance2(p: Point, p0: Point, d: kurbo::Vec2, len2: f64) -> f64 {
+    let t = if len2 > 0.0 {
+        ((p - p0).dot(d) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let e = p - (p0 + d * t);
+    e.x * e.x + e.y * e.y
 }
 
 /// Euclidean distance from `p` to the segment `l`.
