@@ -113,18 +113,31 @@ impl<T: Copy> Grid<T> {
 impl Grid<f32> {
     /// Bilinear interpolation at a continuous pixel position (pixel centres
     /// at half-integers), clamped at the border.
+    #[inline]
     pub fn sample(&self, x: f64, y: f64) -> f32 {
-        let fx = (x - 0.5).clamp(0.0, (self.width - 1) as f64);
+        let w = self.width;
+        let fx = (x - 0.5).clamp(0.0, (w - 1) as f64);
         let fy = (y - 0.5).clamp(0.0, (self.height - 1) as f64);
-        // Both are clamped to ≥ 0 (NaN becomes 0), so truncation is floor.
-        let x0 = fx as usize;
-        let y0 = fy as usize;
-        let x1 = (x0 + 1).min(self.width - 1);
-        let y1 = (y0 + 1).min(self.height - 1);
-        let tx = (fx - x0 as f64) as f32;
-        let ty = (fy - y0 as f64) as f32;
-        let top = self.get(x0, y0) * (1.0 - tx) + self.get(x1, y0) * tx;
-        let bottom = self.get(x0, y1) * (1.0 - tx) + self.get(x1, y1) * tx;
+        // Both are clamped to ≥ 0 (NaN becomes 0) and below the grid's
+        // size, so truncation is floor and the signed cast is exact.
+        let (xi, yi) = (fx as i64, fy as i64);
+        let tx = (fx - xi as f64) as f32;
+        let ty = (fy - yi as f64) as f32;
+        let (x0, y0) = (xi as usize, yi as usize);
+        // The four corners, the next column and row clamped at the border.
+        let i = y0 * w + x0;
+        let dx = usize::from(x0 + 1 < w);
+        let dy = if y0 + 1 < self.height { w } else { 0 };
+        let (Some(&a), Some(&b), Some(&c), Some(&d)) = (
+            self.data.get(i),
+            self.data.get(i + dx),
+            self.data.get(i + dy),
+            self.data.get(i + dy + dx),
+        ) else {
+            return 0.0;
+        };
+        let top = a * (1.0 - tx) + b * tx;
+        let bottom = c * (1.0 - tx) + d * tx;
         top * (1.0 - ty) + bottom * ty
     }
 }
@@ -197,6 +210,29 @@ mod tests {
             for v in [half, f32::from_bits(half.to_bits() - 1), f32::from_bits(half.to_bits() + 1)] {
                 prop_assert_eq!(round_positive(v), v.round());
             }
+        }
+
+        /// Bilinear sampling reads the same bits as the textbook formula
+        /// with the four corners clamped one by one, inside the grid, on
+        /// its border and beyond it.
+        #[test]
+        fn sample_is_clamped_bilinear(
+            w in 1usize..6,
+            h in 1usize..6,
+            x in -3.0f64..9.0,
+            y in -3.0f64..9.0,
+        ) {
+            let g = Grid::from_fn(w, h, |i, j| ((i * 7 + j * 13) % 11) as f32 * 0.37 - 1.5);
+            let fx = (x - 0.5).clamp(0.0, (w - 1) as f64);
+            let fy = (y - 0.5).clamp(0.0, (h - 1) as f64);
+            let (x0, y0) = (fx as usize, fy as usize);
+            let (x1, y1) = ((x0 + 1).min(w - 1), (y0 + 1).min(h - 1));
+            let tx = (fx - x0 as f64) as f32;
+            let ty = (fy - y0 as f64) as f32;
+            let top = g.get(x0, y0) * (1.0 - tx) + g.get(x1, y0) * tx;
+            let bottom = g.get(x0, y1) * (1.0 - tx) + g.get(x1, y1) * tx;
+            let want = top * (1.0 - ty) + bottom * ty;
+            prop_assert_eq!(g.sample(x, y).to_bits(), want.to_bits());
         }
     }
 }
