@@ -168,11 +168,6 @@ struct LinkIndex {
 
 impl LinkIndex {
     // Padded samples run over x in -1..=w, y in -1..=h.
-    fn count(&self) -> usize {
-        let (w, h) = (self.w as usize, self.h as usize);
-        (w + 1) * (h + 2) + (w + 2) * (h + 1)
-    }
-
     fn id(&self, l: Link) -> usize {
         let (w, h) = (self.w as usize, self.h as usize);
         let (x, y) = ((l.x + 1) as usize, (l.y + 1) as usize);
@@ -224,13 +219,9 @@ pub fn extract(values: &Grid<f32>) -> Vec<Contour> {
             *flag = u8::from(v < 0.0);
         }
     }
-    // `next[id]` is the successor's id + 1, 0 for none: a zeroed buffer
-    // is handed out by the allocator without a pass over it, and only the
-    // pages near the outline are ever touched.
-    let mut next = vec![0u32; index.count()];
-    // The links given a successor, so the walk below visits only them (in
-    // id order, as a sweep over all links would).
-    let mut used = Vec::new();
+    // Each crossed link with its successor's id: only the outline's links,
+    // a few bytes each, not a table over every link of the grid.
+    let mut next: Vec<(usize, usize)> = Vec::new();
     // Cells are indexed by their top-left sample (x, y), x in -1..w, y in -1..h.
     let rows = padded.chunks(pw).zip(padded.chunks(pw).skip(1));
     for (yi, (top, bottom)) in rows.enumerate() {
@@ -292,25 +283,27 @@ pub fn extract(values: &Grid<f32>) -> Vec<Contour> {
                         .find(|&k| !corner[k] && corner[(k + 1) % 4])
                         .unwrap_or(e)
                 };
-                let id = index.id(edges[e]);
-                next[id] = index.id(edges[partner]) as u32 + 1;
-                used.push(id);
+                next.push((index.id(edges[e]), index.id(edges[partner])));
             }
         }
     }
+    // Walked in id order, as a sweep over all links would; a link is
+    // crossed by one segment at most, so each id appears once.
+    next.sort_unstable();
+    let mut seen = vec![false; next.len()];
+    let find = |id: usize| next.binary_search_by_key(&id, |&(l, _)| l).ok();
     let mut contours = Vec::new();
-    used.sort_unstable();
-    for &start in &used {
-        if next[start] == 0 {
+    for first in 0..next.len() {
+        if seen[first] {
             continue;
         }
-        // A visited link's successor is cleared, which also marks it seen.
         let mut links = Vec::new();
-        let mut cur = start;
-        while let Some(&succ) = next.get(cur).filter(|&&s| s != 0) {
-            next[cur] = 0;
-            links.push(index.link(cur));
-            cur = succ as usize - 1;
+        let mut at = Some(first);
+        while let Some(i) = at.filter(|&i| !seen[i]) {
+            seen[i] = true;
+            let (id, succ) = next[i];
+            links.push(index.link(id));
+            at = find(succ);
         }
         let points = links.iter().map(|&l| crossing(values, l)).collect();
         contours.push(Contour { links, points });
