@@ -1,6 +1,6 @@
-//! One cubic for one span of an exact outline, fitted directly (the
-//! outline path of [`super::cover`]; SDF contours keep kurbo's
-//! `fit_to_cubic`).
+//! One cubic for one span of an outline or an SDF contour, fitted
+//! directly (what [`super::span::longest_span`] fits for both
+//! [`super::cover`] and [`super::fit`]).
 //!
 //! With the end points and end tangents fixed, a cubic has two free
 //! numbers, its handle lengths. They are chosen so that the cubic encloses
@@ -14,12 +14,12 @@
 //! is bilinear, so it gives `d₁` from `d₀`, and the moment `∫ x y dx`
 //! (quadratic in each handle) then becomes a quartic in `d₀`
 //! ([`handle_lengths`], derived symbolically, checked against kurbo's
-//! fitter in the tests). Each candidate is judged by the outline itself: the
-//! outline's samples must lie near the curve and the curve near the
-//! outline (`Piece::holds`), which is all the fitter is held to, so no
-//! separate error measure along normals is needed (kurbo's fitter measures
-//! each candidate so, and the check would repeat it; SDF contours keep
-//! kurbo's fitter).
+//! fitter in the tests). Each candidate is judged by what the piece is
+//! fitted to: the piece's samples must lie near the curve and the curve
+//! near the outline or the SDF's zero level (`Piece::holds`), which is all
+//! the fitter is held to, so no separate error measure along normals is
+//! needed (kurbo's fitter measures each candidate so, and the check would
+//! repeat it).
 //!
 //! Of the candidates, the best ranked by a rough error ([`rough_error`],
 //! long handles penalised) whose outline samples lie within reach of it,

@@ -37,7 +37,7 @@ fn fit_loop(pts: &[Point], cs: &[usize], sdf: &Sdf, accuracy: f64, out: &mut Bez
     let guide = Guide::Field(sdf);
     let mut pieces: Vec<Piece> = Vec::new();
     if cs.is_empty() {
-        // A smooth loop is fitted as two open halves (kurbo's fitter needs
+        // A smooth loop is fitted as two open halves (a span's fit needs
         // distinct end points); the tangents at the joins come from the
         // guide, so the halves meet with G1 continuity.
         let h = n / 2;
@@ -124,11 +124,11 @@ fn split_by_turning<'a>(piece: &Piece<'a>) -> Vec<Piece<'a>> {
 }
 
 /// Fits one piece with as few cubics as a greedy cover finds: from the
-/// start of what is left, the longest span that one cubic fits (kurbo's
-/// single-cubic fitter, `fit_to_cubic`, which matches area and moment to the
-/// source and measures the error along normals; every cubic also checked
-/// against the SDF itself) is found by halving until a fit succeeds and then
-/// bisecting between that success and the failure above it. Extending each
+/// start of what is left, the longest span that one cubic fits (the
+/// direct fit of [`super::direct`], which matches area and moment to the
+/// source, checked against the SDF itself) is found by halving until a span
+/// passes and then bisecting between that success and the failure above
+/// it, on the cheap test of [`super::span::longest_span`]. Extending each
 /// span as far as it goes is what an optimal cover does when fitting is
 /// monotone in the span, and it needs no merging pass afterwards. Spans
 /// shorter than [`MIN_SPAN_PX`](super::span::MIN_SPAN_PX) that still do not fit fall back to the

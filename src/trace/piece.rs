@@ -629,7 +629,7 @@ impl Piece<'_> {
     }
 
     /// kurbo's default moment integrals (16-point Gauss–Legendre on the
-    /// derivative), kept for SDF contours so their output does not change.
+    /// derivative), for SDF contours (their pieces keep no prefix sums).
     fn quadrature_moments(&self, range: Range<f64>) -> (f64, f64, f64) {
         let t0 = 0.5 * (range.start + range.end);
         let dt = 0.5 * (range.end - range.start);

@@ -5,7 +5,7 @@
 //! a straight chord), and the cubics of a loop gathered into a path.
 
 use super::piece::{Guide, Piece, FIT_SAMPLES};
-use kurbo::{Affine, BezPath, CubicBez, ParamCurve, ParamCurveArclen, Point, Vec2};
+use kurbo::{BezPath, CubicBez, ParamCurve, Point, Vec2};
 use std::ops::Range;
 
 /// Appends the closed loop of consecutive `cubics` to `out` as one subpath
@@ -41,7 +41,7 @@ pub(super) fn line_cubic(a: Point, b: Point) -> CubicBez {
 /// [`MIN_SPAN_PX`] fits, the polygon over that length (it lies on what is
 /// fitted).
 ///
-/// On an exact outline the halving and bisection steps are taken on the
+/// The halving and bisection steps are taken on the
 /// cheap half of the test alone ([`probe`]: the span's samples bend
 /// gently enough, or its chord fits) and only the span they settle on is
 /// fitted and checked in full; if it fails, it becomes the failure above
@@ -108,7 +108,7 @@ pub(super) fn longest_span(
             Known::Fits(c) => Some(c),
             Known::Likely(samples) => {
                 // The samples the probe took: the same range.
-                super::direct::fit_span_direct(piece, start..good, &samples, accuracy)
+                direct(piece, start..good, &samples, accuracy)
                     .or_else(|| chord_span(piece, start..good, accuracy))
             }
         };
@@ -149,14 +149,10 @@ enum Probe {
     Fails,
 }
 
-/// One step of [`longest_span`]'s search over `range`: on an SDF contour
-/// the whole [`fit_span`]; on an exact outline, whether the span's samples
-/// bend gently enough for a cubic ([`is_sharp`]; the fit itself is left
+/// One step of [`longest_span`]'s search over `range`: whether the span's
+/// samples bend gently enough for a cubic ([`is_sharp`]; the fit itself is left
 /// for later), else whether its chord fits (as [`fit_span`] does).
 fn probe(piece: &Piece, range: Range<f64>, accuracy: f64) -> Probe {
-    if let Guide::Field(_) = piece.guide {
-        return fit_span(piece, range, accuracy).map_or(Probe::Fails, Probe::Fits);
-    }
     if let Some(samples) = piece.samples_while(range.clone(), |a, b| !is_sharp(a, b)) {
         return Probe::Likely(Box::new(samples));
     }
@@ -280,33 +276,29 @@ fn simplify(piece: &Piece, pts: &[(Point, f64)], a: usize, b: usize, tol: f64, k
 /// further but kept as a polygon.
 pub(super) const MIN_SPAN_PX: f64 = 1.5;
 
-/// One cubic for `range` of the piece that passes the piece's checks: for
-/// an exact outline the direct fit ([`super::direct`]); for an SDF contour
-/// kurbo's fitter, with the curve also within `accuracy` + [`CHECK_SLACK`](super::piece::CHECK_SLACK)
-/// of the SDF's zero level at 63 points. Either way the curve may not loop
-/// away (arc length at most 1.5× the source's) and the range must not be
-/// "spicy" (see [`is_sharp`]).
+/// One cubic for `range` of the piece that passes the piece's checks: the
+/// direct fit ([`super::direct`]), on an SDF contour within `accuracy` +
+/// [`CHECK_SLACK`](super::piece::CHECK_SLACK) of the zero level and with
+/// its handles on the canvas. The curve may not loop away (arc length at
+/// most 1.5× the source's) and the range must not bend sharply between
+/// samples (see [`is_sharp`]).
 fn fit_checked(piece: &Piece, range: Range<f64>, accuracy: f64) -> Option<CubicBez> {
     let samples = piece.samples_while(range.clone(), |a, b| !is_sharp(a, b))?;
-    if let Guide::Outline(_) = piece.guide {
-        return super::direct::fit_span_direct(piece, range, &samples, accuracy);
-    }
-    let len = piece.length() * (range.end - range.start);
-    let (c, _) = kurbo::fit_to_cubic(piece, range.clone(), piece.reach(accuracy))?;
-    let c = Affine::translate(piece.origin) * c;
-    let s0 = range.start * piece.length();
-    let s1 = range.end * piece.length();
-    let ok = piece.holds((1..64).map(|k| c.eval(k as f64 / 64.0)), s0, s1, accuracy)
-        && c.arclen(0.01) <= 1.5 * len + 0.5
-        && piece.keeps_handles_on_canvas(&c);
-    ok.then_some(c)
+    direct(piece, range, &samples, accuracy)
 }
 
-/// True when kurbo would judge a range "spicy" for these tangents of
-/// neighbouring error samples (more than about 11° apart) and fall back to measuring
-/// error by arc length at 1e-9 accuracy, which is very slow; such ranges
-/// are split first. The outline path keeps the same limit on how sharply
-/// one cubic's source may bend between samples.
+/// The direct fit over `range` from its `samples`
+/// ([`super::direct::fit_span_direct`]), with an SDF contour's handles
+/// also kept on (or a pixel beyond) the canvas.
+fn direct(piece: &Piece, range: Range<f64>, samples: &Samples, accuracy: f64) -> Option<CubicBez> {
+    super::direct::fit_span_direct(piece, range, samples, accuracy)
+        .filter(|c| piece.keeps_handles_on_canvas(c))
+}
+
+/// True when these tangents of neighbouring samples are more than about
+/// 11° apart: one cubic's source may not bend more sharply than that
+/// between samples (kurbo's fitter calls such a range "spicy"); such
+/// ranges are split first.
 fn is_sharp(a: Vec2, b: Vec2) -> bool {
     b.cross(a).abs() > 0.2 * b.dot(a).abs()
 }
