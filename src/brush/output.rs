@@ -12,7 +12,7 @@ use super::synth::{self, Coord, Field};
 use crate::brush::analysis::facts::components;
 use crate::brush::analysis::BrushStyle;
 use crate::error::{Error, Result};
-use crate::raster::{Grid, Sdf};
+use crate::raster::{Bilinear, Grid, Sdf};
 use crate::read::sketch::Sketch;
 use crate::svg_out::{decimals_for, Color, Document, FillRule, Group, Shape};
 use crate::trace::{trace_sdf, TraceOptions};
@@ -310,17 +310,58 @@ struct Source<'a> {
 /// as a band of the edge's samples (a wedge of solid ink wherever a
 /// continued coordinate leaves the image).
 fn sample_beyond(g: &Grid<f32>, x: f32, y: f32) -> f32 {
-    let (w, h) = (g.width() as f32, g.height() as f32);
-    if (0.0..=w).contains(&x) && (0.0..=h).contains(&y) {
-        return g.sample(x as f64, y as f64);
+    Beyond::at(g.width(), g.height(), x, y).read_sized(g)
+}
+
+/// [`sample_beyond`] at one position prepared for every exemplar SDF of
+/// one size (an exemplar's ink and its layers): the bilinear read at the
+/// position, or at the nearest point of the image's edge with the
+/// distance to it.
+#[derive(Clone, Copy)]
+struct Beyond {
+    at: Bilinear,
+    /// Distance from the position to the image (px), 0 inside it.
+    out: f32,
+    size: (usize, usize),
+    x: f32,
+    y: f32,
+}
+
+impl Beyond {
+    /// The read at `(x, y)` (finest px) of a `w`×`h` image.
+    fn at(w: usize, h: usize, x: f32, y: f32) -> Beyond {
+        let (wf, hf) = (w as f32, h as f32);
+        let (cx, cy) = if (0.0..=wf).contains(&x) && (0.0..=hf).contains(&y) {
+            (x, y)
+        } else {
+            (x.clamp(0.0, wf), y.clamp(0.0, hf))
+        };
+        Beyond {
+            at: Bilinear::at(w, h, cx as f64, cy as f64),
+            out: (x - cx).hypot(y - cy),
+            size: (w, h),
+            x,
+            y,
+        }
     }
-    let (cx, cy) = (x.clamp(0.0, w), y.clamp(0.0, h));
-    let v = g.sample(cx as f64, cy as f64);
-    let out = (x - cx).hypot(y - cy);
-    if out > 0.0 {
-        v.max(0.0).hypot(out)
-    } else {
-        v
+
+    /// [`sample_beyond`] of `g` at this position.
+    fn read(&self, g: &Grid<f32>) -> f32 {
+        if (g.width(), g.height()) == self.size {
+            self.read_sized(g)
+        } else {
+            sample_beyond(g, self.x, self.y)
+        }
+    }
+
+    /// The read of `g`, which has this read's size.
+    fn read_sized(&self, g: &Grid<f32>) -> f32 {
+        let v = g.read(&self.at);
+        if self.out > 0.0 {
+            v.max(0.0).hypot(self.out)
+        } else {
+            v
+        }
     }
 }
 
@@ -429,7 +470,7 @@ fn read_layers(
         // Output columns whose four canvas pixels may reach the span.
         let (x0, x1) = ((lo * k).saturating_sub(k), ((hi + 1) * k).min(ow));
         // Continuations: exemplar, finest position, weight.
-        let mut taps: Vec<(usize, f32, f32, f32)> = Vec::with_capacity(4);
+        let mut taps: Vec<(usize, Beyond, f32)> = Vec::with_capacity(4);
         for ox in x0..x1 {
             let px = (ox as f32 + 0.5) / k as f32 - 0.5;
             let i0 = px.floor();
@@ -456,27 +497,24 @@ fn read_layers(
                     continue;
                 };
                 let d = synth::apply(jm, [fx - di as f32, fy - dj as f32]);
-                taps.push((
-                    c.exemplar as usize,
-                    (c.x + d[0]) * s.to_fine,
-                    (c.y + d[1]) * s.to_fine,
-                    wt,
-                ));
+                let (x, y) = ((c.x + d[0]) * s.to_fine, (c.y + d[1]) * s.to_fine);
+                let at = Beyond::at(s.ink.width(), s.ink.height(), x, y);
+                taps.push((c.exemplar as usize, at, wt));
             }
             if taps.is_empty() {
                 continue;
             }
-            let wsum: f32 = taps.iter().map(|t| t.3).sum();
+            let wsum: f32 = taps.iter().map(|t| t.2).sum();
             // Layer `l`, or all ink for `None`.
             let read = |l: Option<usize>| -> f32 {
                 taps.iter()
-                    .map(|&(e, x, y, wt)| {
+                    .map(|&(e, at, wt)| {
                         wt * src(e)
                             .and_then(|s| match l {
                                 None => Some(s.ink),
                                 Some(l) => s.layers.get(l).copied().flatten(),
                             })
-                            .map_or(PAPER, |g| sample_beyond(g, x, y))
+                            .map_or(PAPER, |g| at.read(g))
                     })
                     .sum::<f32>()
                     / wsum

@@ -115,19 +115,15 @@ impl Grid<f32> {
     /// at half-integers), clamped at the border.
     #[inline]
     pub fn sample(&self, x: f64, y: f64) -> f32 {
-        let w = self.width;
-        let fx = (x - 0.5).clamp(0.0, (w - 1) as f64);
-        let fy = (y - 0.5).clamp(0.0, (self.height - 1) as f64);
-        // Both are clamped to ≥ 0 (NaN becomes 0) and below the grid's
-        // size, so truncation is floor and the signed cast is exact.
-        let (xi, yi) = (fx as i64, fy as i64);
-        let tx = (fx - xi as f64) as f32;
-        let ty = (fy - yi as f64) as f32;
-        let (x0, y0) = (xi as usize, yi as usize);
-        // The four corners, the next column and row clamped at the border.
-        let i = y0 * w + x0;
-        let dx = usize::from(x0 + 1 < w);
-        let dy = if y0 + 1 < self.height { w } else { 0 };
+        self.read(&Bilinear::at(self.width, self.height, x, y))
+    }
+
+    /// The value `at` reads: its four samples blended by its weights (0
+    /// where they fall outside the data, which a [`Bilinear`] made for
+    /// this grid's size never does).
+    #[inline]
+    pub fn read(&self, at: &Bilinear) -> f32 {
+        let Bilinear { i, dx, dy, tx, ty } = *at;
         let (Some(&a), Some(&b), Some(&c), Some(&d)) = (
             self.data.get(i),
             self.data.get(i + dx),
@@ -139,6 +135,41 @@ impl Grid<f32> {
         let top = a * (1.0 - tx) + b * tx;
         let bottom = c * (1.0 - tx) + d * tx;
         top * (1.0 - ty) + bottom * ty
+    }
+}
+
+/// Where a bilinear read at one continuous position falls on a grid of a
+/// given size: the index of its top-left sample, the steps to the next
+/// column and row (0 on the last one: clamped at the border) and the
+/// weights. Made once, it reads every grid of that size
+/// ([`Grid::read`]), as [`Grid::sample`] would at the same position.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bilinear {
+    i: usize,
+    dx: usize,
+    dy: usize,
+    tx: f32,
+    ty: f32,
+}
+
+impl Bilinear {
+    /// The read at `(x, y)` (px, pixel centres at half-integers) on a
+    /// `w`×`h` grid (both at least 1), clamped at the border.
+    #[inline]
+    pub fn at(w: usize, h: usize, x: f64, y: f64) -> Bilinear {
+        let fx = (x - 0.5).clamp(0.0, w.saturating_sub(1) as f64);
+        let fy = (y - 0.5).clamp(0.0, h.saturating_sub(1) as f64);
+        // Both are clamped to ≥ 0 (NaN becomes 0) and below the grid's
+        // size, so truncation is floor and the signed cast is exact.
+        let (xi, yi) = (fx as i64, fy as i64);
+        let (x0, y0) = (xi as usize, yi as usize);
+        Bilinear {
+            i: y0 * w + x0,
+            dx: usize::from(x0 + 1 < w),
+            dy: if y0 + 1 < h { w } else { 0 },
+            tx: (fx - xi as f64) as f32,
+            ty: (fy - yi as f64) as f32,
+        }
     }
 }
 
