@@ -39,9 +39,8 @@ pub struct EmParams {
     /// Pyramid levels (1 = finest only), at most: a level is only added
     /// while its tile [`represents_every_layer`].
     pub levels: usize,
-    /// EM iterations `N` per neighbourhood size (a quarter of them at the
-    /// finest level of a pyramid, at least one: CaTS §4.1 reduces the
-    /// iterations at finer levels, whose start is already close).
+    /// EM iterations `N` per neighbourhood size, fewer where a level's
+    /// start is already close ([`iterations_at`]).
     pub iterations: usize,
     /// Level-set time steps per E-step (the paper uses 5).
     pub steps: usize,
@@ -566,12 +565,7 @@ fn synthesize_levels(
             let patch = &sc.patch;
             let spacing = spacing_of(r);
             let mut field = resample_nnf(nnf.take(), atlas, w, h, spacing, patch_reach(r));
-            let n = if level == 0 && levels > 1 {
-                params.iterations.div_ceil(4)
-            } else {
-                params.iterations
-            }
-            .max(1);
+            let n = iterations_at(level, levels, params.iterations);
             // Shape Hint descriptors (ring of radius r, bins r/2) of the
             // exemplars' edges and of the region's outline.
             let hints = match &level_mask {
@@ -583,8 +577,8 @@ fn synthesize_levels(
                 _ => None,
             };
             // Alg. 1's weights, λ from 0.2 and μ from 0.8 in steps of
-            // 0.75/N; a level run with fewer iterations (the finest, whose
-            // start is already close) takes the schedule's last ones.
+            // 0.75/N; a level run with fewer iterations (one whose start is
+            // already close) takes the schedule's last ones.
             let full = params.iterations.max(n);
             let skipped = (full - n) as f32 * 0.75 / full as f32;
             let (mut lambda, mut mu) = (0.2 + skipped, 0.8 - skipped);
@@ -678,6 +672,29 @@ fn synthesize_levels(
         colour: st.colour,
         energy,
     }
+}
+
+/// EM iterations per neighbourhood size at pyramid level `level` (0
+/// finest) of `levels`, given `N` = `iterations`: fewer where the level
+/// starts close to its result, as CaTS §4.1 reduces them at finer levels.
+/// The finest level of a pyramid (the upsampled coarser result) runs a
+/// quarter of `N`; a coarsest level at half the finest resolution (a
+/// pyramid of two) half of `N`: it starts from quilting's copy of the
+/// exemplar, whose energy is near zero and which Alg. 1's E-steps raise,
+/// yet they still mend the quilt's seams and follow the field's turns. A
+/// coarsest level at a quarter of the resolution or coarser, which lays
+/// out the whole pattern at little cost, the middle levels, whose
+/// upsampled start is still far, and a single level run all `N`. At least
+/// one everywhere.
+pub fn iterations_at(level: usize, levels: usize, iterations: usize) -> usize {
+    let n = if levels > 1 && level == 0 {
+        iterations.div_ceil(4)
+    } else if levels == 2 && level == 1 {
+        iterations.div_ceil(2)
+    } else {
+        iterations
+    };
+    n.max(1)
 }
 
 /// Shortest side, pixels, of a swatch that is not periodic at any pyramid

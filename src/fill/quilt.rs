@@ -205,9 +205,9 @@ fn quilt_blocks(
             // Every allowed centre when there are few, else a seeded
             // sample. A candidate is kept only when its error is within
             // 10 % of the best, so one whose partial error is already over
-            // that much of the best seen so far (in its chunk) is out: its
-            // error is left infinite, which changes neither the best nor
-            // the kept ones.
+            // that much of the best seen so far (in its chunk, or among the
+            // continuations below) is out: its error is left infinite,
+            // which changes neither the best nor the kept ones.
             let n = q.centres.len();
             let count = if n <= o.candidates {
                 n
@@ -222,10 +222,32 @@ fn quilt_blocks(
                 };
                 (x as usize, y as usize)
             };
+            // The continuations of the blocks already laid (a tile's own
+            // repeat; allowed centres, so among the candidates when every
+            // centre is one) are scored first: the best of them bounds
+            // every chunk's search from the start, since no candidate over
+            // `keep_bound` of it can be within 10 % of the overall best.
+            let continued: Vec<(usize, usize, f32)> = {
+                let bring = |ox: u32, oy: u32, rx: i64, ry: i64| {
+                    let k = atlas.block_of(oy as usize);
+                    let (x, y) = atlas.bring_in(k, ox as i64 + rx, oy as i64 + ry, q.reach);
+                    atlas.allowed(x, y).then_some((x as usize, y as usize))
+                };
+                let angle = |x: u32, y: u32| source.angle.get(x as usize, y as usize);
+                continuations(&map, &filled, (bx, by), b, ta, angle, bring)
+                    .into_iter()
+                    .map(|(sx, sy)| (sx, sy, overlap_err(sx, sy, f32::INFINITY)))
+                    .collect()
+            };
+            let start = continued
+                .iter()
+                .filter(|c| n > o.candidates || q.centres.contains(&(c.0 as u32, c.1 as u32)))
+                .map(|c| c.2)
+                .fold(f32::INFINITY, f32::min);
             let chunks: Vec<Vec<(usize, usize, f32)>> = (0..count.div_ceil(CHUNK))
                 .into_par_iter()
                 .map(|c| {
-                    let mut best = f32::INFINITY;
+                    let mut best = start;
                     (c * CHUNK..((c + 1) * CHUNK).min(count))
                         .map(|k| {
                             let (sx, sy) = position(k);
@@ -238,15 +260,7 @@ fn quilt_blocks(
                 .collect();
             let mut cands: Vec<(usize, usize, f32)> = chunks.into_iter().flatten().collect();
             if n > o.candidates {
-                let bring = |ox: u32, oy: u32, rx: i64, ry: i64| {
-                    let k = atlas.block_of(oy as usize);
-                    let (x, y) = atlas.bring_in(k, ox as i64 + rx, oy as i64 + ry, q.reach);
-                    atlas.allowed(x, y).then_some((x as usize, y as usize))
-                };
-                let angle = |x: u32, y: u32| source.angle.get(x as usize, y as usize);
-                for (sx, sy) in continuations(&map, &filled, (bx, by), b, ta, angle, bring) {
-                    cands.push((sx, sy, overlap_err(sx, sy, f32::INFINITY)));
-                }
+                cands.extend(continued);
             }
             let best = cands.iter().map(|c| c.2).fold(f32::INFINITY, f32::min);
             let good: Vec<&(usize, usize, f32)> =

@@ -201,6 +201,17 @@ fn energy_decreases_over_the_em_iterations_at_each_level() {
     };
     let s = em::synthesize(&tile, &dir, &params);
     assert_eq!(s.energy.len(), 2);
+    // Each level records its start and one energy per M-step: the
+    // coarsest, at half resolution, runs half of the six iterations per
+    // neighbourhood size (two sizes there), the finest a quarter.
+    assert_eq!(s.energy[0].len(), 1 + 2 * 3, "{:?}", s.energy);
+    assert_eq!(s.energy[1].len(), 1 + 2, "{:?}", s.energy);
+    // Three levels: the coarsest and the middle one run all six.
+    for (level, want) in [(0, 2), (1, 6), (2, 6)] {
+        assert_eq!(em::iterations_at(level, 3, 6), want, "level {level}");
+    }
+    assert_eq!(em::iterations_at(0, 1, 6), 6);
+    assert_eq!(em::iterations_at(0, 2, 1), 1);
     // Levels after the coarsest start from the upsampled image and must
     // improve on it. The coarsest starts from the quilted copy, whose
     // interior energy is already 0 (every neighbourhood a tile
