@@ -330,12 +330,8 @@ struct Beyond {
 impl Beyond {
     /// The read at `(x, y)` (finest px) of a `w`×`h` image.
     fn at(w: usize, h: usize, x: f32, y: f32) -> Beyond {
-        let (wf, hf) = (w as f32, h as f32);
-        let (cx, cy) = if (0.0..=wf).contains(&x) && (0.0..=hf).contains(&y) {
-            (x, y)
-        } else {
-            (x.clamp(0.0, wf), y.clamp(0.0, hf))
-        };
+        // Inside the image the clamp leaves the position as it is.
+        let (cx, cy) = (x.clamp(0.0, w as f32), y.clamp(0.0, h as f32));
         Beyond {
             at: Bilinear::at(w, h, cx as f64, cy as f64),
             out: (x - cx).hypot(y - cy),

@@ -195,7 +195,8 @@ const CURVE_SPACING: f64 = 0.4;
 /// length) that lies within `accuracy` of the outline both ways: each of
 /// the outline's [`FIT_SAMPLES`] samples (`samples`, interior ones used)
 /// within the piece's reach of the curve, and the curve within `accuracy`
-/// of the outline (`Piece::holds`, which also admits the corridor), checked
+/// of the outline (`Piece::holds`, which also admits the corridor; on an
+/// SDF contour, with the handles on the canvas), checked
 /// on the best ranked candidate that keeps the samples within reach
 /// (ranked by [`rough_error`], long handles penalised as above; the others
 /// are not tried in the last check: they are the loops and hooks, and
@@ -272,7 +273,7 @@ pub(super) fn fit_span_direct(
     let short = polygon <= 1.5 * len + 0.5
         || pts.cum[pts.m] <= 1.5 * len + 0.5
             && kurbo::ParamCurveArclen::arclen(&c, 0.01) <= 1.5 * len + 0.5;
-    (short && piece.holds(fine, s0, s1, accuracy)).then_some(c)
+    (short && piece.keeps_handles_on_canvas(&c) && piece.holds(fine, s0, s1, accuracy)).then_some(c)
 }
 
 /// The points of a cubic at parameters k/m, k = 1, 2, …, by forward

@@ -190,7 +190,7 @@ impl<'a> Piece<'a> {
     /// For an SDF contour, whether the control points of `c` stay within a
     /// pixel of the canvas: ink running off the canvas is closed along its
     /// border (see [`clipped_value`]), where the contour is a straight run
-    /// and kurbo may put a handle many pixels past the canvas's edge with
+    /// and a fit may put a handle many pixels past the canvas's edge with
     /// the curve itself still on it.
     pub(super) fn keeps_handles_on_canvas(&self, c: &CubicBez) -> bool {
         let Guide::Field(sdf) = self.guide else {

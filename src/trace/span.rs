@@ -108,7 +108,7 @@ pub(super) fn longest_span(
             Known::Fits(c) => Some(c),
             Known::Likely(samples) => {
                 // The samples the probe took: the same range.
-                direct(piece, start..good, &samples, accuracy)
+                super::direct::fit_span_direct(piece, start..good, &samples, accuracy)
                     .or_else(|| chord_span(piece, start..good, accuracy))
             }
         };
@@ -284,15 +284,7 @@ pub(super) const MIN_SPAN_PX: f64 = 1.5;
 /// samples (see [`is_sharp`]).
 fn fit_checked(piece: &Piece, range: Range<f64>, accuracy: f64) -> Option<CubicBez> {
     let samples = piece.samples_while(range.clone(), |a, b| !is_sharp(a, b))?;
-    direct(piece, range, &samples, accuracy)
-}
-
-/// The direct fit over `range` from its `samples`
-/// ([`super::direct::fit_span_direct`]), with an SDF contour's handles
-/// also kept on (or a pixel beyond) the canvas.
-fn direct(piece: &Piece, range: Range<f64>, samples: &Samples, accuracy: f64) -> Option<CubicBez> {
-    super::direct::fit_span_direct(piece, range, samples, accuracy)
-        .filter(|c| piece.keeps_handles_on_canvas(c))
+    super::direct::fit_span_direct(piece, range, &samples, accuracy)
 }
 
 /// True when these tangents of neighbouring samples are more than about
