@@ -32,7 +32,7 @@
 //! along the piece, and given up at the first pair of tangents too sharp
 //! for one cubic.
 
-use super::nearest::nearest_from;
+use super::nearest::first_within;
 use super::piece::{Piece, FIT_SAMPLES};
 use kurbo::common::{factor_quartic_inner, solve_cubic, solve_quadratic};
 use kurbo::{CubicBez, Point, Vec2};
@@ -388,15 +388,20 @@ impl CurvePoints {
     fn set(&mut self, c: &CubicBez) {
         let polygon = (c.p1 - c.p0).hypot() + (c.p2 - c.p1).hypot() + (c.p3 - c.p2).hypot();
         let m = check_chords(polygon);
-        let (pts, cum) = (&mut self.pts, &mut self.cum);
-        pts[0] = c.p0;
-        cum[0] = 0.0;
+        // The interior points stepped along, the end point exact; each
+        // length the one before plus the chord to the new point.
         let mut steps = Steps::new(c, m);
-        for k in 1..=m {
-            let p = steps.next_point();
-            pts[k] = if k == m { c.p3 } else { p };
-            cum[k] = cum[k - 1] + (pts[k] - pts[k - 1]).hypot();
+        let (mut prev, mut acc) = (c.p0, 0.0);
+        self.pts[0] = prev;
+        self.cum[0] = acc;
+        let inner = 1..m;
+        for (p, s) in self.pts[inner.clone()].iter_mut().zip(&mut self.cum[inner]) {
+            let q = steps.next_point();
+            acc += (q - prev).hypot();
+            (*p, *s, prev) = (q, acc, q);
         }
+        self.pts[m] = c.p3;
+        self.cum[m] = acc + (c.p3 - prev).hypot();
         self.m = m;
     }
 
@@ -420,9 +425,8 @@ const STEP_SLACK: f64 = 0.15;
 /// flattened curve, or `None` once one
 /// exceeds `limit`. Each sample's first chord within `limit` is searched
 /// from the last one found (samples and curve both run from start to end;
-/// chords out of reach are skipped by their arc length, see
-/// [`nearest_segment`](super::nearest::nearest_segment)), then followed downhill to a local minimum: an upper
-/// bound of the distance, exact where the curve is smooth.
+/// see [`first_within`]), then followed downhill to a local minimum: an
+/// upper bound of the distance, exact where the curve is smooth.
 fn outline_to_curve(curve: &CurvePoints, samples: &[(Point, Vec2)], limit: f64) -> Option<f64> {
     let (pts, cum) = (curve.points(), curve.lengths());
     let m = curve.m;
@@ -438,8 +442,7 @@ fn outline_to_curve(curve: &CurvePoints, samples: &[(Point, Vec2)], limit: f64) 
     let total = cum[m];
     let slack = 2.0 * limit + STEP_SLACK * total;
     for (i, &(q, _)) in interior.iter().enumerate() {
-        let (found, d) = nearest_from(pts, cum, q, 0, cursor, last, limit, limit);
-        let (mut j, mut best) = (found?, d);
+        let (mut j, mut best) = first_within(pts, cum, q, 0, cursor, last, limit)?;
         // Downhill to the nearest chord around it: the closer neighbour
         // (ahead on a tie) while it is closer, and on in that direction
         // only (the chord just left is farther than the new one).

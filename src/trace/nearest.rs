@@ -2,7 +2,8 @@
 //! ([`super::fit`]'s `Piece::holds`): each curve sample must lie within a
 //! distance of the outline, and most samples of a long span are far from
 //! most of its segments, so segments that cannot be close are skipped by
-//! their arc length.
+//! their arc length; and the direct fit's search for a chord of a
+//! flattened cubic near an outline sample ([`first_within`]).
 
 use kurbo::Point;
 
@@ -34,7 +35,7 @@ pub(super) fn nearest_segment(
     let mut bound = far;
     let mut j = from;
     // The first segment is measured outright: the search mostly starts
-    // where the point lies (`nearest_from`'s cursor), and there the bound
+    // where the point lies (`Piece::holds`' cursor), and there the bound
     // below only costs a root and a galloping search.
     if j <= to && j + 1 < pts.len() {
         let d = crate::raster::sdf::point_segment_distance(p, kurbo::Line::new(pts[j], pts[j + 1]));
@@ -77,28 +78,61 @@ pub(super) fn nearest_segment(
     (None, best)
 }
 
-/// [`nearest_segment`] for consecutive points along a curve: segments
-/// `cursor..=hi` first (a point is usually near the segment the last one
-/// was, or just ahead), then `lo..cursor`. Returns a segment within `near`
-/// if either finds one, else the distance of the closest within `far`.
-#[allow(clippy::too_many_arguments)]
-pub(super) fn nearest_from(
+/// The first segment of the short polyline `pts` (a flattened cubic,
+/// `cum` its cumulative chord lengths, px) within `limit` px of `p`, with
+/// its distance: segments `cursor..=hi` first (a point is usually near the
+/// segment the last one was, or just ahead), then `lo..cursor`; `None` if
+/// none is. This is what [`nearest_segment`] answers with `near` = `far` =
+/// `limit`, by the same bound (a segment whose end lies less than
+/// `|p − pts[j]| − limit` along the polyline from vertex `j` cannot come
+/// within `limit`), stepped over one segment at a time: the polyline's
+/// dozens of segments leave a galloping search little to save.
+pub(super) fn first_within(
     pts: &[Point],
     cum: &[f64],
     p: Point,
     lo: usize,
     cursor: usize,
     hi: usize,
-    near: f64,
-    far: f64,
-) -> (Option<usize>, f64) {
-    match nearest_segment(pts, cum, p, cursor, hi, near, far) {
-        (None, d) if cursor > lo => {
-            let (j, d2) = nearest_segment(pts, cum, p, lo, cursor - 1, near, far);
-            (j, d.min(d2))
+    limit: f64,
+) -> Option<(usize, f64)> {
+    // Margin (px) for the rounding of the bound, far below any distance
+    // that matters.
+    const MARGIN: f64 = 1e-6;
+    let last = pts.len().min(cum.len()).saturating_sub(2);
+    let r = limit + MARGIN;
+    let scan = |from: usize, to: usize| {
+        let to = to.min(last);
+        let mut j = from;
+        while j <= to {
+            let a = pts[j];
+            let v2 = (p - a).hypot2();
+            let len = cum[j + 1] - cum[j];
+            if v2 > (r + len) * (r + len) {
+                // Out of reach, and so is every segment ending less than
+                // `|p − a| − r` further on.
+                let target = cum[j] + v2.sqrt() - r;
+                j += 1;
+                while j <= to && cum[j + 1] < target {
+                    j += 1;
+                }
+                continue;
+            }
+            let d = crate::raster::sdf::point_segment_distance(p, kurbo::Line::new(a, pts[j + 1]));
+            if d <= limit {
+                return Some((j, d));
+            }
+            j += 1;
         }
-        found => found,
-    }
+        None
+    };
+    scan(cursor, hi).or_else(|| {
+        if cursor > lo {
+            scan(lo, cursor - 1)
+        } else {
+            None
+        }
+    })
 }
 
 /// The number of leading values of ascending `c` below `target`, found by
@@ -204,6 +238,43 @@ mod tests {
                     prop_assert_eq!(best <= far, any_far);
                 }
             }
+        }
+
+        /// The plain scan answers as the search with skips does when
+        /// `near` = `far`: the same first segment, at the same distance.
+        #[test]
+        fn first_within_matches_nearest_segment(
+            steps in prop::collection::vec((-1.0f64..1.0, -1.0f64..1.0), 2..70),
+            px in -10.0f64..10.0,
+            py in -10.0f64..10.0,
+            limit in 0.05f64..1.5,
+            cursor_share in 0.0f64..1.0,
+            lo_share in 0.0f64..1.0,
+        ) {
+            let mut pts = vec![Point::ORIGIN];
+            for (dx, dy) in steps {
+                let last = pts[pts.len() - 1];
+                pts.push(last + Vec2::new(dx, dy));
+            }
+            let n = pts.len();
+            let mut cum = vec![0.0];
+            for w in pts.windows(2) {
+                cum.push(cum[cum.len() - 1] + (w[1] - w[0]).hypot());
+            }
+            let p = Point::new(px, py);
+            let cursor = ((n - 2) as f64 * cursor_share) as usize;
+            let lo = (cursor as f64 * lo_share) as usize;
+            let expected = match nearest_segment(&pts, &cum, p, cursor, n - 2, limit, limit) {
+                (Some(j), d) => Some((j, d)),
+                (None, _) if cursor > lo => {
+                    match nearest_segment(&pts, &cum, p, lo, cursor - 1, limit, limit) {
+                        (Some(j), d) => Some((j, d)),
+                        (None, _) => None,
+                    }
+                }
+                (None, _) => None,
+            };
+            prop_assert_eq!(first_within(&pts, &cum, p, lo, cursor, n - 2, limit), expected);
         }
     }
 }

@@ -523,7 +523,9 @@ impl Piece<'_> {
         let mut out = [(Point::ORIGIN, Vec2::ZERO); FIT_SAMPLES];
         if let (Guide::Outline(_), true) = (self.guide, step >= 0.0) {
             if self.tangents.len() == self.pts.len() && self.pts.len() >= 2 {
-                return self.outline_samples_while(range.start, step, ok, out);
+                return self
+                    .outline_samples_while(range.start, step, ok, &mut out)
+                    .then_some(out);
             }
         }
         let mut prev: Option<Vec2> = None;
@@ -549,17 +551,18 @@ impl Piece<'_> {
 
     /// [`Self::samples_while`] on an outline with its tangents given, for
     /// ascending samples from `start` by `step` (shares of the length):
-    /// the same samples, [`Self::sample_at`]'s outline branch written out
-    /// on one cursor over the segments, so a sample costs a step along
-    /// the outline and an interpolated tangent.
+    /// the same samples written into `out` (false once `ok` rejects two
+    /// neighbours), [`Self::sample_at`]'s outline branch written out on
+    /// one cursor over the segments, so a sample costs a step along the
+    /// outline and an interpolated tangent.
     fn outline_samples_while(
         &self,
         start: f64,
         step: f64,
         ok: impl Fn(Vec2, Vec2) -> bool,
-        mut out: [(Point, Vec2); FIT_SAMPLES],
-    ) -> Option<[(Point, Vec2); FIT_SAMPLES]> {
-        let (pts, cum, tangents) = (&self.pts, &self.cum, &self.tangents);
+        out: &mut [(Point, Vec2); FIT_SAMPLES],
+    ) -> bool {
+        let (pts, cum, tangents) = (&self.pts[..], &self.cum[..], &self.tangents[..]);
         let n = pts.len();
         let len = self.length();
         let o = self.origin;
@@ -567,43 +570,50 @@ impl Piece<'_> {
         let mut prev: Option<Vec2> = None;
         for (k, slot) in out.iter_mut().enumerate() {
             let t = start + k as f64 * step;
-            let s = (t * len).clamp(0.0, len);
+            let raw = t * len;
+            let s = raw.clamp(0.0, len);
             while i + 2 < n && cum[i + 1] <= s {
                 i += 1;
             }
-            let seg = cum[i + 1] - cum[i];
-            let f = if seg > 0.0 { (s - cum[i]) / seg } else { 0.0 };
+            let c0 = cum[i];
+            let seg = cum[i + 1] - c0;
+            let f = if seg > 0.0 { (s - c0) / seg } else { 0.0 };
             let p = pts[i].lerp(pts[i + 1], f);
             let at_start = t <= 0.0;
             let at_end = t >= 1.0;
             let tangent = if (at_start && self.corner_start) || (at_end && self.corner_end) {
-                self.chord_dir(t * len, at_start || !at_end)
+                self.chord_dir(raw, at_start || !at_end)
             } else {
+                // The tangents' share of the segment: the point's own
+                // where the arc length needed no clamping.
                 let g = if seg > 0.0 {
-                    ((t * len - cum[i]) / seg).clamp(0.0, 1.0)
+                    if raw == s {
+                        f.clamp(0.0, 1.0)
+                    } else {
+                        ((raw - c0) / seg).clamp(0.0, 1.0)
+                    }
                 } else {
                     0.0
                 };
                 let v = tangents[i].lerp(tangents[i + 1], g);
                 let l = v.hypot();
-                let s = t * len;
                 if l > 1e-9 {
                     v / l
-                } else if self.corner_start && s < CORNER_REACH
-                    || self.corner_end && len - s < CORNER_REACH
+                } else if self.corner_start && raw < CORNER_REACH
+                    || self.corner_end && len - raw < CORNER_REACH
                 {
-                    self.chord_dir(s, self.corner_start && s < CORNER_REACH)
+                    self.chord_dir(raw, self.corner_start && raw < CORNER_REACH)
                 } else {
                     self.seg_dir(i)
                 }
             };
             if prev.is_some_and(|q| !ok(q, tangent)) {
-                return None;
+                return false;
             }
             prev = Some(tangent);
             *slot = ((p - o) + o, tangent);
         }
-        Some(out)
+        true
     }
 
     /// Position (px) and unit tangent at the start (`at_start`) or end of
