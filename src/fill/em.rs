@@ -1030,13 +1030,19 @@ fn vote(pb: &Problem, nnf: &Nnf, lv: &Level, hist: &[[f32; 2]], w: usize, h: usi
                             continue;
                         };
                         let mut wh0 = 1.0;
-                        for (l, &v) in px[..layers].iter().enumerate() {
-                            let wh = hist[l][usize::from(v >= 0.0)];
+                        let o = xu * layers;
+                        let sums = row.sdf[o..o + layers]
+                            .iter_mut()
+                            .zip(&mut row.sdf_weight[o..o + layers]);
+                        for (l, ((s, sw), (&v, hl))) in
+                            sums.zip(px[..layers].iter().zip(hist)).enumerate()
+                        {
+                            let wh = hl[usize::from(v >= 0.0)];
                             if l == 0 {
                                 wh0 = wh;
                             }
-                            row.sdf[xu * layers + l] += wh * v;
-                            row.sdf_weight[xu * layers + l] += wh;
+                            *s += wh * v;
+                            *sw += wh;
                         }
                         row.count[xu] += 1.0;
                         let wv = wc * wh0;
