@@ -25,7 +25,7 @@ use super::quilt::{block_reach, QuiltOptions, Quilter};
 use super::shape::{self, Histogram, ShapeHint};
 use super::tile::Tile;
 use crate::field::DirectionGrid;
-use crate::raster::Grid;
+use crate::raster::{Bilinear, Grid};
 use rayon::prelude::*;
 use std::sync::OnceLock;
 
@@ -834,34 +834,28 @@ fn resample_nnf(
 }
 
 /// Bilinear upsampling to the next level: distances doubled (pixel unit
-/// halves), colours interpolated.
+/// halves), colours interpolated. Each pixel's read position on the
+/// coarser grid is found once and read from every layer and channel.
 fn upsample(prev: &State, w: usize, h: usize) -> State {
     let (pw, ph) = (prev.colour.width(), prev.colour.height());
-    let pos = |x: usize, y: usize| {
-        (
+    let chans: Vec<Grid<f32>> = (0..3).map(|k| prev.colour.map(|c| c[k])).collect();
+    let mut phi: Vec<Vec<f32>> = prev.phi.iter().map(|_| Vec::with_capacity(w * h)).collect();
+    let colour = Grid::from_fn(w, h, |x, y| {
+        let at = Bilinear::at(
+            pw,
+            ph,
             (x as f64 + 0.5) * pw as f64 / w as f64,
             (y as f64 + 0.5) * ph as f64 / h as f64,
-        )
-    };
-    let phi = prev
-        .phi
-        .iter()
-        .map(|g| {
-            Grid::from_fn(w, h, |x, y| {
-                let (u, v) = pos(x, y);
-                2.0 * g.sample(u, v)
-            })
-        })
-        .collect();
-    let chans: Vec<Grid<f32>> = (0..3).map(|k| prev.colour.map(|c| c[k])).collect();
-    let colour = Grid::from_fn(w, h, |x, y| {
-        let (u, v) = pos(x, y);
-        [
-            chans[0].sample(u, v),
-            chans[1].sample(u, v),
-            chans[2].sample(u, v),
-        ]
+        );
+        for (out, g) in phi.iter_mut().zip(&prev.phi) {
+            out.push(2.0 * g.read(&at));
+        }
+        [chans[0].read(&at), chans[1].read(&at), chans[2].read(&at)]
     });
+    let phi = phi
+        .into_iter()
+        .map(|v| Grid::from_vec(w, h, v).expect("one value per pixel by construction"))
+        .collect();
     State { phi, colour }
 }
 
@@ -1036,13 +1030,19 @@ fn vote(pb: &Problem, nnf: &Nnf, lv: &Level, hist: &[[f32; 2]], w: usize, h: usi
                             continue;
                         };
                         let mut wh0 = 1.0;
-                        for (l, &v) in px[..layers].iter().enumerate() {
-                            let wh = hist[l][usize::from(v >= 0.0)];
+                        let o = xu * layers;
+                        let sums = row.sdf[o..o + layers]
+                            .iter_mut()
+                            .zip(&mut row.sdf_weight[o..o + layers]);
+                        for (l, ((s, sw), (&v, hl))) in
+                            sums.zip(px[..layers].iter().zip(hist)).enumerate()
+                        {
+                            let wh = hl[usize::from(v >= 0.0)];
                             if l == 0 {
                                 wh0 = wh;
                             }
-                            row.sdf[xu * layers + l] += wh * v;
-                            row.sdf_weight[xu * layers + l] += wh;
+                            *s += wh * v;
+                            *sw += wh;
                         }
                         row.count[xu] += 1.0;
                         let wv = wc * wh0;

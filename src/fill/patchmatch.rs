@@ -592,11 +592,18 @@ impl<'a> Problem<'a> {
             }
             best
         });
-        // Propagation by jump flooding (CaTS Alg. 6).
+        // Propagation by jump flooding (CaTS Alg. 6). A proposal that is
+        // the centre's match from before this round, or one another
+        // neighbour already proposed in this pass, was scored against a
+        // best at least as high as the current one and lost (or is the
+        // best): scoring it again cannot change the match.
+        let before = nnf.matches.clone();
         for step in [4usize, 2, 1] {
             nnf.matches = self.each_active(nnf, &nnf.matches, |buf, k, q, mut best| {
                 let (i, j) = (k % nnf.cols, k / nnf.cols);
                 let mut gathered = false;
+                let mut tried = [(before[k].x as usize, before[k].y as usize); 5];
+                let mut n_tried = 1;
                 let neighbours = [
                     (i.checked_sub(step), Some(j)),
                     (Some(i + step).filter(|&v| v < nnf.cols), Some(j)),
@@ -615,9 +622,11 @@ impl<'a> Problem<'a> {
                     let Some(p) = self.bring((n.x, n.y), mx, my) else {
                         continue;
                     };
-                    if p == (best.x as usize, best.y as usize) {
+                    if p == (best.x as usize, best.y as usize) || tried[..n_tried].contains(&p) {
                         continue;
                     }
+                    tried[n_tried] = p;
+                    n_tried += 1;
                     if !gathered {
                         self.target_patch(q.0, q.1, buf);
                         gathered = true;

@@ -37,6 +37,10 @@ pub const BAND: f32 = 3.0;
 /// the sample on the ink side of `v < 0`.
 pub const MIN_INSIDE: f32 = 1e-3;
 
+/// Slack, pixels, by which the exact band's scan passes [`BAND`]: more
+/// than an `f32` rounding of a distance near it.
+const SPARE: f64 = 1e-3;
+
 /// A signed distance field: one layer of ink as distances (px) at pixel
 /// centres, negative inside, plus the map from pixel coordinates to the
 /// input's user units.
@@ -215,9 +219,27 @@ fn distance_to_segments(inside: &Grid<bool>, segments: &[Line]) -> Grid<f32> {
                     .min(row0 + nrows - 1);
                 let d = l.p1 - l.p0;
                 let len2 = d.hypot2();
+                let (lx0, lx1) = (l.p0.x.min(l.p1.x), l.p0.x.max(l.p1.x));
+                let (ly0, ly1) = (l.p0.y.min(l.p1.y), l.p0.y.max(l.p1.y));
                 for y in y0..=y1 {
+                    // Only distances within BAND are kept (the rest come
+                    // from the EDT): a pixel centre farther than BAND from
+                    // the segment's bounding box is farther from the
+                    // segment, so each row visits the centres within BAND
+                    // of the box (with a hair to spare for rounding).
+                    let cy = y as f64 + 0.5;
+                    let gy = (ly0 - cy).max(cy - ly1).max(0.0);
+                    if gy > band + SPARE {
+                        continue;
+                    }
+                    let half = (band * band - gy * gy).max(0.0).sqrt() + SPARE;
+                    let xa = ((lx0 - half - 0.5).ceil().max(0.0) as usize).max(x0);
+                    let xb = ((lx1 + half - 0.5).floor().max(0.0) as usize).min(x1);
+                    if xa > xb {
+                        continue;
+                    }
                     let row = &mut rows[(y - row0) * w..(y - row0 + 1) * w];
-                    for (x, slot) in row.iter_mut().enumerate().take(x1 + 1).skip(x0) {
+                    for (x, slot) in row.iter_mut().enumerate().take(xb + 1).skip(xa) {
                         let p = Point::new(x as f64 + 0.5, y as f64 + 0.5);
                         let d2 = point_segment_distance2(p, l.p0, d, len2);
                         let held = *slot as f64;
