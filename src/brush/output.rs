@@ -625,12 +625,13 @@ fn final_layers_with(style: &BrushStyle, r: &QueryResult, field: Field) -> Vec<(
         return layers;
     };
     let (w, h) = (first.width(), first.height());
+    let scale = out_per_fine(style, r);
+    bridge_fragments(style, &mut layers, scale);
     let ink = Grid::from_fn(w, h, |x, y| layers.iter().any(|(_, g)| g.get(x, y) < 0));
     let comps = components(&ink);
     // A query shorter than every exemplar can have a body smaller than
     // the exemplars' smallest piece: the largest piece always stays.
     let largest = comps.iter().map(Vec::len).max().unwrap_or(0);
-    let scale = out_per_fine(style, r);
     let smallest = (debris_area(style) * scale * scale).round() as usize;
     let min = smallest.min(largest);
     // A piece drawn where a refinement sketch asked for ink is the
@@ -654,6 +655,228 @@ fn final_layers_with(style: &BrushStyle, r: &QueryResult, field: Field) -> Vec<(
         }
     }
     layers
+}
+
+/// How far a fragment's nearest ink may lie for [`bridge_fragments`] to
+/// join them, in the style's thinnest lines: a seam that cuts a line
+/// leaves its two ends about a line apart.
+pub const BRIDGE_LINES: f64 = 3.0;
+
+/// Joins each fragment to the ink it was cut from: an ink piece smaller
+/// than the exemplars' smallest drawn element
+/// ([`crate::brush::analysis::facts::StyleFacts::smallest_piece`]) is a
+/// stretch of line a seam left apart (decobrush.txt §5 cuts between
+/// patches wherever they differ least, which on a hairline is across it).
+/// Its nearest ink of another piece, if within [`BRIDGE_LINES`] of the
+/// style's thinnest lines, is joined to it ([`bridge`]). Pieces as large
+/// as an exemplar element are never joined, so separate leaves and dots
+/// stay apart; specks under [`debris_area`] are left to the cleanup.
+/// `scale`: output px per finest exemplar px.
+fn bridge_fragments(style: &BrushStyle, layers: &mut [(Color, Grid<i16>)], scale: f64) {
+    let px = |a: f64| (a * scale * scale).round() as usize;
+    let sizes = Fragments {
+        fragment: px(style.facts.smallest_piece as f64),
+        speck: px(debris_area(style)),
+        line: (style.facts.thinnest_line * scale).max(1.0),
+    };
+    bridge(layers, sizes);
+}
+
+/// What [`bridge`] joins, output px.
+#[derive(Clone, Copy, Debug)]
+struct Fragments {
+    /// Pieces smaller than this many px² are fragments.
+    fragment: usize,
+    /// Pieces smaller than this many px² are specks, cleared rather
+    /// than joined, and never a fragment's target.
+    speck: usize,
+    /// The thinnest line's thickness, px.
+    line: f64,
+}
+
+/// Joins each fragment (a piece of `sizes.speck` ..
+/// `sizes.fragment` px², never the largest) to the nearest pixel of
+/// another piece that is not a speck, if within [`BRIDGE_LINES`] lines,
+/// by a bar as thick as the thinner of the two pieces there and no wider
+/// than the gap is long (ends that nearly touch get a thin join, not a
+/// knob), drawn into the layer that inks the fragment at its end: the
+/// union of that layer's distance and the bar's.
+fn bridge(layers: &mut [(Color, Grid<i16>)], sizes: Fragments) {
+    let Some((_, first)) = layers.first() else {
+        return;
+    };
+    let (w, h) = (first.width(), first.height());
+    let ink = Grid::from_fn(w, h, |x, y| layers.iter().any(|(_, g)| g.get(x, y) < 0));
+    let comps = components(&ink);
+    if comps.len() < 2 {
+        return;
+    }
+    let Fragments {
+        fragment,
+        speck: specks,
+        line,
+    } = sizes;
+    let reach = BRIDGE_LINES * line;
+    // The layer that inks each pixel most deeply, which a bar from it is
+    // drawn into.
+    let colour: Vec<u8> = (0..w * h)
+        .map(|i| {
+            (0..layers.len())
+                .min_by_key(|&l| layers[l].1.data()[i])
+                .map_or(0, |l| l.min(255) as u8)
+        })
+        .collect();
+    let mut label = vec![usize::MAX; w * h];
+    for (k, c) in comps.iter().enumerate() {
+        for &i in c {
+            label[i] = k;
+        }
+    }
+    // A short query's body can be smaller than the exemplars' smallest
+    // piece; it is never a fragment.
+    let largest = comps.iter().map(Vec::len).max().unwrap_or(0);
+    let mut bars = Vec::new();
+    for (k, c) in comps.iter().enumerate() {
+        if c.len() >= fragment.min(largest) || c.len() < specks {
+            continue;
+        }
+        if let Some((p, q)) = nearest_other(c, k, &label, &comps, specks, w, h, reach) {
+            // The bar is as thick as the thinner of the two lines it joins.
+            let depth = |piece: &[usize], at: usize| {
+                let (ax, ay) = ((at % w) as f64, (at / w) as f64);
+                piece
+                    .iter()
+                    .filter(|&&i| {
+                        let (dx, dy) = ((i % w) as f64 - ax, (i / w) as f64 - ay);
+                        dx * dx + dy * dy <= reach * reach
+                    })
+                    .map(|&i| {
+                        -f64::from(layers[usize::from(colour[i])].1.data()[i])
+                            * f64::from(LAYER_STEP)
+                    })
+                    .fold(0.0f64, f64::max)
+            };
+            // and no wider than the gap is long, so that ends which nearly
+            // touch get a thin join, not a knob.
+            let gap = {
+                let (dx, dy) = (
+                    (p % w) as f64 - (q % w) as f64,
+                    (p / w) as f64 - (q / w) as f64,
+                );
+                (dx * dx + dy * dy).sqrt()
+            };
+            let radius = depth(c, p)
+                .min(depth(&comps[label[q]], q))
+                .min(0.5 * gap)
+                .max(0.5);
+            bars.push((p, q, radius));
+        }
+    }
+    for (p, q, radius) in bars {
+        let (px, py) = ((p % w) as f64 + 0.5, (p / w) as f64 + 0.5);
+        let (qx, qy) = ((q % w) as f64 + 0.5, (q / w) as f64 + 0.5);
+        let Some((_, g)) = layers.get_mut(usize::from(colour[p])) else {
+            continue;
+        };
+        let pad = radius + 1.0;
+        let x0 = (px.min(qx) - pad).floor().max(0.0) as usize;
+        let y0 = (py.min(qy) - pad).floor().max(0.0) as usize;
+        let x1 = ((px.max(qx) + pad).ceil() as usize).min(w);
+        let y1 = ((py.max(qy) + pad).ceil() as usize).min(h);
+        let seg = kurbo::Line::new((px, py), (qx, qy));
+        for y in y0..y1 {
+            for x in x0..x1 {
+                let c = kurbo::Point::new(x as f64 + 0.5, y as f64 + 0.5);
+                let d = kurbo::ParamCurveNearest::nearest(&seg, c, 1e-6)
+                    .distance_sq
+                    .sqrt()
+                    - radius;
+                let v = &mut g.data_mut()[y * w + x];
+                *v = (*v).min(pack(d as f32));
+            }
+        }
+    }
+}
+
+/// The closest pair (fragment pixel, pixel of another piece) for piece
+/// `k` (pixel indices `piece`, labels `label` on a `w` × `h` grid), the
+/// other piece's pixel at most `reach` px from the fragment's: a
+/// breadth-first sweep over paper from all the piece's pixels, each
+/// visited pixel carrying its nearest piece pixel.
+#[allow(clippy::too_many_arguments)]
+fn nearest_other(
+    piece: &[usize],
+    k: usize,
+    label: &[usize],
+    comps: &[Vec<usize>],
+    specks: usize,
+    w: usize,
+    h: usize,
+    reach: f64,
+) -> Option<(usize, usize)> {
+    let r = reach.ceil() as usize + 1;
+    let (mut x0, mut y0, mut x1, mut y1) = (usize::MAX, usize::MAX, 0, 0);
+    for &i in piece {
+        let (x, y) = (i % w, i / w);
+        x0 = x0.min(x);
+        y0 = y0.min(y);
+        x1 = x1.max(x);
+        y1 = y1.max(y);
+    }
+    let (bx0, by0) = (x0.saturating_sub(r), y0.saturating_sub(r));
+    let (bx1, by1) = ((x1 + r + 1).min(w), (y1 + r + 1).min(h));
+    let bw = bx1 - bx0;
+    let local = |i: usize| (i / w - by0) * bw + (i % w - bx0);
+    let mut src = vec![usize::MAX; bw * (by1 - by0)];
+    let mut queue = std::collections::VecDeque::new();
+    for &i in piece {
+        src[local(i)] = i;
+        queue.push_back(i);
+    }
+    let dist2 = |a: usize, b: usize| {
+        let (dx, dy) = (
+            (a % w) as f64 - (b % w) as f64,
+            (a / w) as f64 - (b / w) as f64,
+        );
+        dx * dx + dy * dy
+    };
+    let mut best: Option<(f64, usize, usize)> = None;
+    while let Some(i) = queue.pop_front() {
+        let s = src[local(i)];
+        let (x, y) = (i % w, i / w);
+        for (dx, dy) in [
+            (-1, 0),
+            (1, 0),
+            (0, -1),
+            (0, 1),
+            (-1, -1),
+            (1, -1),
+            (-1, 1),
+            (1, 1),
+        ] {
+            let (nx, ny) = (x as isize + dx, y as isize + dy);
+            if nx < bx0 as isize || ny < by0 as isize || nx >= bx1 as isize || ny >= by1 as isize {
+                continue;
+            }
+            let j = ny as usize * w + nx as usize;
+            let d2 = dist2(s, j);
+            if d2 > reach * reach {
+                continue;
+            }
+            if label[j] != usize::MAX && label[j] != k {
+                if comps[label[j]].len() >= specks && best.is_none_or(|(b, _, _)| d2 < b) {
+                    best = Some((d2, s, j));
+                }
+                continue;
+            }
+            let lj = local(j);
+            if label[j] == usize::MAX && src[lj] == usize::MAX {
+                src[lj] = s;
+                queue.push_back(j);
+            }
+        }
+    }
+    best.map(|(_, p, q)| (p, q))
 }
 
 /// Traces a synthesized query into one group of filled shapes, bottom
@@ -921,4 +1144,95 @@ pub fn brush_sketch(style: &BrushStyle, sketch: &Sketch, opts: &Settings) -> Res
         warnings,
         notes,
     })
+}
+
+#[cfg(test)]
+mod bridge_tests {
+    use super::*;
+
+    /// One layer on a 60 × 20 grid: horizontal lines `[x0, x1] × [7, 9]`
+    /// (px, a 2-px line), as exact signed distances packed like
+    /// [`read_layers`]'s.
+    fn lines(spans: &[(f64, f64)]) -> Vec<(Color, Grid<i16>)> {
+        let g = Grid::from_fn(60, 20, |x, y| {
+            let (cx, cy) = (x as f64 + 0.5, y as f64 + 0.5);
+            let d = spans
+                .iter()
+                .map(|&(x0, x1)| {
+                    let dx = (x0 - cx).max(cx - x1);
+                    let dy = (7.0 - cy).max(cy - 9.0);
+                    if dx > 0.0 && dy > 0.0 {
+                        dx.hypot(dy)
+                    } else {
+                        dx.max(dy)
+                    }
+                })
+                .fold(f64::MAX, f64::min);
+            pack(d as f32)
+        });
+        vec![(Color::BLACK, g)]
+    }
+
+    fn pieces(layers: &[(Color, Grid<i16>)]) -> Vec<usize> {
+        let g = &layers[0].1;
+        let ink = Grid::from_fn(g.width(), g.height(), |x, y| g.get(x, y) < 0);
+        components(&ink).iter().map(Vec::len).collect()
+    }
+
+    const SIZES: Fragments = Fragments {
+        fragment: 40,
+        speck: 6,
+        line: 2.0,
+    };
+
+    /// A stretch of line cut off by a gap under [`BRIDGE_LINES`] lines is
+    /// joined to the line it was cut from, by a bar no thicker than the
+    /// line; the rest of the grid is untouched.
+    #[test]
+    fn a_fragment_near_its_line_is_joined() {
+        let mut layers = lines(&[(2.0, 40.0), (44.0, 56.0)]);
+        let before = layers[0].1.clone();
+        assert_eq!(pieces(&layers), vec![76, 24]);
+        bridge(&mut layers, SIZES);
+        assert_eq!(pieces(&layers).len(), 1);
+        let g = &layers[0].1;
+        for y in 0..20 {
+            for x in 0..60 {
+                let changed = g.get(x, y) != before.get(x, y);
+                // Only between the two ends, within the line's rows.
+                assert!(
+                    !changed || ((39..=44).contains(&x) && (6..=9).contains(&y)),
+                    "{x},{y}"
+                );
+                if g.get(x, y) < 0 {
+                    assert!((7..=8).contains(&y), "ink off the line at {x},{y}");
+                }
+            }
+        }
+    }
+
+    /// Nothing is joined across a gap wider than [`BRIDGE_LINES`] lines,
+    /// to a speck, or between two pieces of an exemplar element's size.
+    #[test]
+    fn far_pieces_specks_and_elements_stay_apart() {
+        for (spans, sizes) in [
+            // 8 px apart: more than three 2-px lines.
+            (vec![(2.0, 40.0), (48.0, 56.0)], SIZES),
+            // The near piece is a speck (4 px²).
+            (vec![(2.0, 40.0), (43.0, 45.0)], SIZES),
+            // Both pieces are at least an element.
+            (
+                vec![(2.0, 40.0), (44.0, 56.0)],
+                Fragments {
+                    fragment: 24,
+                    ..SIZES
+                },
+            ),
+        ] {
+            let mut layers = lines(&spans);
+            let before = layers[0].1.clone();
+            bridge(&mut layers, sizes);
+            assert_eq!(layers[0].1, before, "{spans:?}");
+        }
+    }
 }
