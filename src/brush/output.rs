@@ -626,9 +626,15 @@ fn final_layers_with(style: &BrushStyle, r: &QueryResult, field: Field) -> Vec<(
     };
     let (w, h) = (first.width(), first.height());
     let scale = out_per_fine(style, r);
-    bridge_fragments(style, &mut layers, scale);
-    let ink = Grid::from_fn(w, h, |x, y| layers.iter().any(|(_, g)| g.get(x, y) < 0));
-    let comps = components(&ink);
+    let ink_pieces = |layers: &[(Color, Grid<i16>)]| {
+        components(&Grid::from_fn(w, h, |x, y| {
+            layers.iter().any(|(_, g)| g.get(x, y) < 0)
+        }))
+    };
+    let mut comps = ink_pieces(&layers);
+    if bridge_fragments(style, &mut layers, &comps, scale) {
+        comps = ink_pieces(&layers);
+    }
     // A query shorter than every exemplar can have a body smaller than
     // the exemplars' smallest piece: the largest piece always stays.
     let largest = comps.iter().map(Vec::len).max().unwrap_or(0);
@@ -672,14 +678,21 @@ pub const BRIDGE_LINES: f64 = 3.0;
 /// as an exemplar element are never joined, so separate leaves and dots
 /// stay apart; specks under [`debris_area`] are left to the cleanup.
 /// `scale`: output px per finest exemplar px.
-fn bridge_fragments(style: &BrushStyle, layers: &mut [(Color, Grid<i16>)], scale: f64) {
+/// `comps`: the layers' ink pieces ([`components`]). True when a bar was
+/// drawn.
+fn bridge_fragments(
+    style: &BrushStyle,
+    layers: &mut [(Color, Grid<i16>)],
+    comps: &[Vec<usize>],
+    scale: f64,
+) -> bool {
     let px = |a: f64| (a * scale * scale).round() as usize;
     let sizes = Fragments {
         fragment: px(style.facts.smallest_piece as f64),
         speck: px(debris_area(style)),
         line: (style.facts.thinnest_line * scale).max(1.0),
     };
-    bridge(layers, sizes);
+    bridge(layers, comps, sizes)
 }
 
 /// What [`bridge`] joins, output px.
@@ -700,47 +713,45 @@ struct Fragments {
 /// by a bar as thick as the thinner of the two pieces there and no wider
 /// than the gap is long (ends that nearly touch get a thin join, not a
 /// knob), drawn into the layer that inks the fragment at its end: the
-/// union of that layer's distance and the bar's.
-fn bridge(layers: &mut [(Color, Grid<i16>)], sizes: Fragments) {
+/// union of that layer's distance and the bar's. `comps`: the layers'
+/// ink pieces ([`components`]). True when a bar was drawn.
+fn bridge(layers: &mut [(Color, Grid<i16>)], comps: &[Vec<usize>], sizes: Fragments) -> bool {
     let Some((_, first)) = layers.first() else {
-        return;
+        return false;
     };
     let (w, h) = (first.width(), first.height());
-    let ink = Grid::from_fn(w, h, |x, y| layers.iter().any(|(_, g)| g.get(x, y) < 0));
-    let comps = components(&ink);
-    if comps.len() < 2 {
-        return;
-    }
     let Fragments {
         fragment,
         speck: specks,
         line,
     } = sizes;
-    let reach = BRIDGE_LINES * line;
-    // The layer that inks each pixel most deeply, which a bar from it is
-    // drawn into.
-    let colour: Vec<u8> = (0..w * h)
-        .map(|i| {
-            (0..layers.len())
-                .min_by_key(|&l| layers[l].1.data()[i])
-                .map_or(0, |l| l.min(255) as u8)
-        })
-        .collect();
-    let mut label = vec![usize::MAX; w * h];
-    for (k, c) in comps.iter().enumerate() {
-        for &i in c {
-            label[i] = k;
-        }
-    }
     // A short query's body can be smaller than the exemplars' smallest
     // piece; it is never a fragment.
     let largest = comps.iter().map(Vec::len).max().unwrap_or(0);
+    let is_fragment = |c: &Vec<usize>| c.len() >= specks && c.len() < fragment.min(largest);
+    if !comps.iter().any(is_fragment) {
+        return false;
+    }
+    let reach = BRIDGE_LINES * line;
+    // The layer that inks a pixel most deeply, which a bar from it is
+    // drawn into.
+    let colour = |layers: &[(Color, Grid<i16>)], i: usize| {
+        (0..layers.len())
+            .min_by_key(|&l| layers[l].1.data()[i])
+            .unwrap_or(0)
+    };
+    let mut label = vec![u32::MAX; w * h];
+    for (k, c) in comps.iter().enumerate() {
+        for &i in c {
+            label[i] = k as u32;
+        }
+    }
     let mut bars = Vec::new();
     for (k, c) in comps.iter().enumerate() {
-        if c.len() >= fragment.min(largest) || c.len() < specks {
+        if !is_fragment(c) {
             continue;
         }
-        if let Some((p, q)) = nearest_other(c, k, &label, &comps, specks, w, h, reach) {
+        if let Some((p, q)) = nearest_other(c, k, &label, comps, specks, w, h, reach) {
             // The bar is as thick as the thinner of the two lines it joins.
             let depth = |piece: &[usize], at: usize| {
                 let (ax, ay) = ((at % w) as f64, (at / w) as f64);
@@ -751,8 +762,7 @@ fn bridge(layers: &mut [(Color, Grid<i16>)], sizes: Fragments) {
                         dx * dx + dy * dy <= reach * reach
                     })
                     .map(|&i| {
-                        -f64::from(layers[usize::from(colour[i])].1.data()[i])
-                            * f64::from(LAYER_STEP)
+                        -f64::from(layers[colour(layers, i)].1.data()[i]) * f64::from(LAYER_STEP)
                     })
                     .fold(0.0f64, f64::max)
             };
@@ -766,16 +776,17 @@ fn bridge(layers: &mut [(Color, Grid<i16>)], sizes: Fragments) {
                 (dx * dx + dy * dy).sqrt()
             };
             let radius = depth(c, p)
-                .min(depth(&comps[label[q]], q))
+                .min(depth(&comps[label[q] as usize], q))
                 .min(0.5 * gap)
                 .max(0.5);
-            bars.push((p, q, radius));
+            bars.push((p, q, radius, colour(layers, p)));
         }
     }
-    for (p, q, radius) in bars {
+    let drawn = !bars.is_empty();
+    for (p, q, radius, l) in bars {
         let (px, py) = ((p % w) as f64 + 0.5, (p / w) as f64 + 0.5);
         let (qx, qy) = ((q % w) as f64 + 0.5, (q / w) as f64 + 0.5);
-        let Some((_, g)) = layers.get_mut(usize::from(colour[p])) else {
+        let Some((_, g)) = layers.get_mut(l) else {
             continue;
         };
         let pad = radius + 1.0;
@@ -796,6 +807,7 @@ fn bridge(layers: &mut [(Color, Grid<i16>)], sizes: Fragments) {
             }
         }
     }
+    drawn
 }
 
 /// The closest pair (fragment pixel, pixel of another piece) for piece
@@ -807,7 +819,7 @@ fn bridge(layers: &mut [(Color, Grid<i16>)], sizes: Fragments) {
 fn nearest_other(
     piece: &[usize],
     k: usize,
-    label: &[usize],
+    label: &[u32],
     comps: &[Vec<usize>],
     specks: usize,
     w: usize,
@@ -863,14 +875,14 @@ fn nearest_other(
             if d2 > reach * reach {
                 continue;
             }
-            if label[j] != usize::MAX && label[j] != k {
-                if comps[label[j]].len() >= specks && best.is_none_or(|(b, _, _)| d2 < b) {
+            if label[j] != u32::MAX && label[j] as usize != k {
+                if comps[label[j] as usize].len() >= specks && best.is_none_or(|(b, _, _)| d2 < b) {
                     best = Some((d2, s, j));
                 }
                 continue;
             }
             let lj = local(j);
-            if label[j] == usize::MAX && src[lj] == usize::MAX {
+            if label[j] == u32::MAX && src[lj] == usize::MAX {
                 src[lj] = s;
                 queue.push_back(j);
             }
@@ -1173,10 +1185,15 @@ mod bridge_tests {
         vec![(Color::BLACK, g)]
     }
 
-    fn pieces(layers: &[(Color, Grid<i16>)]) -> Vec<usize> {
+    fn ink_pieces(layers: &[(Color, Grid<i16>)]) -> Vec<Vec<usize>> {
         let g = &layers[0].1;
-        let ink = Grid::from_fn(g.width(), g.height(), |x, y| g.get(x, y) < 0);
-        components(&ink).iter().map(Vec::len).collect()
+        components(&Grid::from_fn(g.width(), g.height(), |x, y| {
+            g.get(x, y) < 0
+        }))
+    }
+
+    fn pieces(layers: &[(Color, Grid<i16>)]) -> Vec<usize> {
+        ink_pieces(layers).iter().map(Vec::len).collect()
     }
 
     const SIZES: Fragments = Fragments {
@@ -1193,7 +1210,8 @@ mod bridge_tests {
         let mut layers = lines(&[(2.0, 40.0), (44.0, 56.0)]);
         let before = layers[0].1.clone();
         assert_eq!(pieces(&layers), vec![76, 24]);
-        bridge(&mut layers, SIZES);
+        let comps = ink_pieces(&layers);
+        assert!(bridge(&mut layers, &comps, SIZES));
         assert_eq!(pieces(&layers).len(), 1);
         let g = &layers[0].1;
         for y in 0..20 {
@@ -1231,7 +1249,8 @@ mod bridge_tests {
         ] {
             let mut layers = lines(&spans);
             let before = layers[0].1.clone();
-            bridge(&mut layers, sizes);
+            let comps = ink_pieces(&layers);
+            assert!(!bridge(&mut layers, &comps, sizes));
             assert_eq!(layers[0].1, before, "{spans:?}");
         }
     }
