@@ -767,7 +767,8 @@ fn bridge(layers: &mut [(Color, Grid<i16>)], comps: &[Vec<usize>], sizes: Fragme
                     .fold(0.0f64, f64::max)
             };
             // and no wider than the gap is long, so that ends which nearly
-            // touch get a thin join, not a knob.
+            // touch get a thin join, not a knob; at least 1.5 px across, so
+            // that ends touching only at a pixel's corner join edge to edge.
             let gap = {
                 let (dx, dy) = (
                     (p % w) as f64 - (q % w) as f64,
@@ -778,7 +779,7 @@ fn bridge(layers: &mut [(Color, Grid<i16>)], comps: &[Vec<usize>], sizes: Fragme
             let radius = depth(c, p)
                 .min(depth(&comps[label[q] as usize], q))
                 .min(0.5 * gap)
-                .max(0.5);
+                .max(0.75);
             bars.push((p, q, radius, colour(layers, p)));
         }
     }

@@ -4,6 +4,7 @@
 
 mod end_to_end;
 mod many;
+mod seams;
 mod stages;
 
 use crate::brush::analysis::{AnalysisOptions, BrushStyle};
