@@ -1204,8 +1204,8 @@ mod bridge_tests {
     };
 
     /// A stretch of line cut off by a gap under [`BRIDGE_LINES`] lines is
-    /// joined to the line it was cut from, by a bar no thicker than the
-    /// line; the rest of the grid is untouched.
+    /// joined to the line it was cut from, by a bar that inks only the gap
+    /// on the line's rows; distances elsewhere are untouched.
     #[test]
     fn a_fragment_near_its_line_is_joined() {
         let mut layers = lines(&[(2.0, 40.0), (44.0, 56.0)]);
@@ -1217,15 +1217,18 @@ mod bridge_tests {
         let g = &layers[0].1;
         for y in 0..20 {
             for x in 0..60 {
-                let changed = g.get(x, y) != before.get(x, y);
-                // Only between the two ends, within the line's rows.
+                let inked = g.get(x, y) < 0 && before.get(x, y) >= 0;
+                // New ink only between the two ends, on the line's rows.
                 assert!(
-                    !changed || ((39..=44).contains(&x) && (6..=9).contains(&y)),
+                    !inked || ((40..=43).contains(&x) && (7..=8).contains(&y)),
+                    "ink off the gap at {x},{y}"
+                );
+                // Distances change only around the bar.
+                let changed = g.get(x, y) != before.get(x, y);
+                assert!(
+                    !changed || ((37..=46).contains(&x) && (5..=10).contains(&y)),
                     "{x},{y}"
                 );
-                if g.get(x, y) < 0 {
-                    assert!((7..=8).contains(&y), "ink off the line at {x},{y}");
-                }
             }
         }
     }
