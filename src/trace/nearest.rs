@@ -187,6 +187,21 @@ mod tests {
     use kurbo::Vec2;
     use proptest::prelude::*;
 
+    /// A polyline from the origin by `steps`, with its cumulative arc
+    /// lengths.
+    fn polyline(steps: &[(f64, f64)]) -> (Vec<Point>, Vec<f64>) {
+        let mut pts = vec![Point::ORIGIN];
+        for &(dx, dy) in steps {
+            let last = pts[pts.len() - 1];
+            pts.push(last + Vec2::new(dx, dy));
+        }
+        let mut cum = vec![0.0];
+        for w in pts.windows(2) {
+            cum.push(cum[cum.len() - 1] + (w[1] - w[0]).hypot());
+        }
+        (pts, cum)
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(200))]
 
@@ -210,16 +225,8 @@ mod tests {
             extra in 0.0f64..1.0,
             from_share in 0.0f64..1.0,
         ) {
-            let mut pts = vec![Point::ORIGIN];
-            for (dx, dy) in steps {
-                let last = pts[pts.len() - 1];
-                pts.push(last + Vec2::new(dx, dy));
-            }
+            let (pts, cum) = polyline(&steps);
             let n = pts.len();
-            let mut cum = vec![0.0];
-            for w in pts.windows(2) {
-                cum.push(cum[cum.len() - 1] + (w[1] - w[0]).hypot());
-            }
             let far = near + extra;
             let p = Point::new(px, py);
             let from = ((n - 2) as f64 * from_share) as usize;
@@ -251,16 +258,8 @@ mod tests {
             cursor_share in 0.0f64..1.0,
             lo_share in 0.0f64..1.0,
         ) {
-            let mut pts = vec![Point::ORIGIN];
-            for (dx, dy) in steps {
-                let last = pts[pts.len() - 1];
-                pts.push(last + Vec2::new(dx, dy));
-            }
+            let (pts, cum) = polyline(&steps);
             let n = pts.len();
-            let mut cum = vec![0.0];
-            for w in pts.windows(2) {
-                cum.push(cum[cum.len() - 1] + (w[1] - w[0]).hypot());
-            }
             let p = Point::new(px, py);
             let cursor = ((n - 2) as f64 * cursor_share) as usize;
             let lo = (cursor as f64 * lo_share) as usize;
