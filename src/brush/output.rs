@@ -735,10 +735,17 @@ fn bridge(layers: &mut [(Color, Grid<i16>)], comps: &[Vec<usize>], sizes: Fragme
     let reach = BRIDGE_LINES * line;
     // The layer that inks a pixel most deeply, which a bar from it is
     // drawn into.
-    let colour = |layers: &[(Color, Grid<i16>)], i: usize| {
+    let colour = |i: usize| {
         (0..layers.len())
             .min_by_key(|&l| layers[l].1.data()[i])
             .unwrap_or(0)
+    };
+    // How deep a pixel lies in ink, px.
+    let depth_at = |i: usize| {
+        layers
+            .iter()
+            .map(|(_, g)| -f64::from(g.data()[i]) * f64::from(LAYER_STEP))
+            .fold(0.0f64, f64::max)
     };
     let mut label = vec![u32::MAX; w * h];
     for (k, c) in comps.iter().enumerate() {
@@ -751,7 +758,7 @@ fn bridge(layers: &mut [(Color, Grid<i16>)], comps: &[Vec<usize>], sizes: Fragme
         if !is_fragment(c) {
             continue;
         }
-        if let Some((p, q)) = nearest_other(c, k, &label, comps, specks, w, h, reach) {
+        if let Some((p, q, gap)) = nearest_other(c, k, &label, comps, specks, w, h, reach) {
             // The bar is as thick as the thinner of the two lines it joins.
             let depth = |piece: &[usize], at: usize| {
                 let (ax, ay) = ((at % w) as f64, (at / w) as f64);
@@ -761,26 +768,17 @@ fn bridge(layers: &mut [(Color, Grid<i16>)], comps: &[Vec<usize>], sizes: Fragme
                         let (dx, dy) = ((i % w) as f64 - ax, (i / w) as f64 - ay);
                         dx * dx + dy * dy <= reach * reach
                     })
-                    .map(|&i| {
-                        -f64::from(layers[colour(layers, i)].1.data()[i]) * f64::from(LAYER_STEP)
-                    })
+                    .map(|&i| depth_at(i))
                     .fold(0.0f64, f64::max)
             };
             // and no wider than the gap is long, so that ends which nearly
             // touch get a thin join, not a knob; at least 1.5 px across, so
             // that ends touching only at a pixel's corner join edge to edge.
-            let gap = {
-                let (dx, dy) = (
-                    (p % w) as f64 - (q % w) as f64,
-                    (p / w) as f64 - (q / w) as f64,
-                );
-                (dx * dx + dy * dy).sqrt()
-            };
             let radius = depth(c, p)
                 .min(depth(&comps[label[q] as usize], q))
                 .min(0.5 * gap)
                 .max(0.75);
-            bars.push((p, q, radius, colour(layers, p)));
+            bars.push((p, q, radius, colour(p)));
         }
     }
     let drawn = !bars.is_empty();
@@ -799,10 +797,7 @@ fn bridge(layers: &mut [(Color, Grid<i16>)], comps: &[Vec<usize>], sizes: Fragme
         for y in y0..y1 {
             for x in x0..x1 {
                 let c = kurbo::Point::new(x as f64 + 0.5, y as f64 + 0.5);
-                let d = kurbo::ParamCurveNearest::nearest(&seg, c, 1e-6)
-                    .distance_sq
-                    .sqrt()
-                    - radius;
+                let d = crate::raster::sdf::point_segment_distance(c, seg) - radius;
                 let v = &mut g.data_mut()[y * w + x];
                 *v = (*v).min(pack(d as f32));
             }
@@ -811,9 +806,10 @@ fn bridge(layers: &mut [(Color, Grid<i16>)], comps: &[Vec<usize>], sizes: Fragme
     drawn
 }
 
-/// The closest pair (fragment pixel, pixel of another piece) for piece
-/// `k` (pixel indices `piece`, labels `label` on a `w` × `h` grid), the
-/// other piece's pixel at most `reach` px from the fragment's: a
+/// The closest pair (fragment pixel, pixel of another piece, their
+/// distance in px) for piece `k` (pixel indices `piece`, labels `label`
+/// on a `w` × `h` grid), the other piece's pixel at most `reach` px from
+/// the fragment's: a
 /// breadth-first sweep over paper from all the piece's pixels, each
 /// visited pixel carrying its nearest piece pixel.
 #[allow(clippy::too_many_arguments)]
@@ -826,7 +822,7 @@ fn nearest_other(
     w: usize,
     h: usize,
     reach: f64,
-) -> Option<(usize, usize)> {
+) -> Option<(usize, usize, f64)> {
     let r = reach.ceil() as usize + 1;
     let (mut x0, mut y0, mut x1, mut y1) = (usize::MAX, usize::MAX, 0, 0);
     for &i in piece {
@@ -889,7 +885,7 @@ fn nearest_other(
             }
         }
     }
-    best.map(|(_, p, q)| (p, q))
+    best.map(|(d2, p, q)| (p, q, d2.sqrt()))
 }
 
 /// Traces a synthesized query into one group of filled shapes, bottom
